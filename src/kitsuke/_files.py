@@ -1,0 +1,82 @@
+"""Safe file handling: atomic writes and the rule that an input is never overwritten (SPEC §2)."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import tempfile
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+from .errors import InputError
+
+
+def require_file(path: str | os.PathLike[str], *, what: str = "file") -> Path:
+    """Return `path` as a Path, or raise InputError if it is missing, a folder or empty."""
+    p = Path(path)
+    if not p.exists():
+        raise InputError(f"{what} not found", p)
+    if p.is_dir():
+        raise InputError(f"is a folder, expected a {what}", p)
+    if p.stat().st_size == 0:
+        raise InputError(f"{what} is empty", p)
+    return p
+
+
+def check_output(path: str | os.PathLike[str], inputs: Sequence[str | os.PathLike[str]] = ()) -> Path:
+    """Refuse an output path that is one of the inputs or whose folder cannot be made."""
+    out = Path(path)
+    for i in inputs:
+        if Path(i).exists() and out.exists() and os.path.samefile(i, out):
+            raise InputError("refusing to overwrite an input file; choose another output", out)
+    if out.exists() and out.is_dir():
+        raise InputError("output is a folder, expected a file name", out)
+    return out
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """Yield a temporary path beside `path`; on success it is renamed onto `path`, on failure removed.
+
+    Readers never see a half-written file, and a failed write leaves the old file as it was.
+    """
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=out.suffix + ".tmp", dir=out.parent)
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        yield tmp_path
+        os.replace(tmp_path, out)
+    except BaseException:
+        tmp_path.unlink(missing_ok=True)
+        raise
+
+
+def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(data)
+    return Path(path)
+
+
+def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:
+    return write_bytes_atomic(path, text.encode("utf-8"))
+
+
+def write_json_atomic(path: str | os.PathLike[str], obj: Any) -> Path:
+    return write_text_atomic(path, json.dumps(obj, indent=1, allow_nan=False) + "\n")
+
+
+def read_json(path: str | os.PathLike[str], *, what: str = "JSON file") -> Any:
+    """Read JSON, turning every failure into an InputError naming the file."""
+    p = require_file(path, what=what)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise InputError(f"not a text {what} (not UTF-8)", p) from None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as e:
+        raise InputError(f"invalid JSON at line {e.lineno} column {e.colno}: {e.msg}", p) from None

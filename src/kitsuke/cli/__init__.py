@@ -1,0 +1,94 @@
+"""The `kitsuke` command: `kitsuke <group> <verb> ...`.
+
+Thin by design: each group module (`cli/<group>.py`) parses its arguments and calls the library. Errors follow SPEC §2:
+bad input -> one line on stderr naming the file and the problem, exit code 2; an internal error -> exit code 1
+(set KITSUKE_DEBUG=1 for the traceback).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import sys
+import traceback
+
+from ..errors import InputError
+
+#: group name -> (module under kitsuke.cli, one-line help). Modules are imported only when their group runs or
+#: when `--help` lists them, so `kitsuke --help` stays fast.
+GROUPS: dict[str, tuple[str, str]] = {
+    "demo": ("demo", "write the default body, kimono pattern and renders to out/"),
+    "body": ("body", "inspect and convert body meshes"),
+    "pattern": ("pattern", "convert, validate, mesh and generate sewing patterns"),
+    "render": ("render", "render meshes to PNG"),
+    "pose": ("pose", "extract poses from video/images/camera/BVH and correct them for a kimono"),
+}
+
+EPILOG = """\
+examples:
+  kitsuke demo                                   # default body + kimono into out/
+  kitsuke body info body.obj                     # units, size, holes, rig
+  kitsuke pattern kimono -o kimono.json          # standard-size kimono pattern
+  kitsuke pattern convert shirt_spec.json shirt.svg
+  kitsuke pattern mesh kimono.json -o kimono.obj
+  kitsuke render body.glb -o front.png --view front
+
+Run `kitsuke <group> --help` for a group's verbs and options.
+"""
+
+
+class _Parser(argparse.ArgumentParser):
+    """ArgumentParser whose usage errors are one line plus the hint to ask for --help (exit 2)."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="kitsuke",
+        description="kitsuke: put garments on 3D people (sketch-based dressing, kimono try-on mirror).",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    from .. import __version__
+
+    parser.add_argument("--version", action="version", version=f"kitsuke {__version__}")
+    sub = parser.add_subparsers(dest="group", metavar="<group>", parser_class=_Parser)
+    for name, (module, help_text) in GROUPS.items():
+        if only is not None and name != only:
+            sub.add_parser(name, help=help_text)
+            continue
+        mod = importlib.import_module(f".{module}", __name__)
+        mod.register(sub.add_parser(name, help=help_text, description=help_text, parser_class=_Parser))
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    group = next((a for a in argv if not a.startswith("-")), None)
+    parser = build_parser(only=group if group in GROUPS else None)
+    args = parser.parse_args(argv)
+    if getattr(args, "run", None) is None:
+        # A group without a verb: show what it offers.
+        target = parser if args.group is None else parser._subparsers._group_actions[0].choices[args.group]  # type: ignore[union-attr]
+        target.print_help()
+        return 2 if args.group is None else 0
+    try:
+        return int(args.run(args) or 0)
+    except InputError as e:
+        print(f"kitsuke: error: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("kitsuke: interrupted", file=sys.stderr)
+        return 130
+    except Exception as e:  # noqa: BLE001 - the last line of defence: an internal error, not the user's fault
+        if os.environ.get("KITSUKE_DEBUG"):
+            traceback.print_exc()
+        print(f"kitsuke: internal error: {type(e).__name__}: {e} (set KITSUKE_DEBUG=1 for details)", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

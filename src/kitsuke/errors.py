@@ -1,0 +1,28 @@
+"""Error types shared by the library and the command line.
+
+`InputError` is what bad input raises anywhere in kitsuke; the CLI turns it into one line on stderr and exit code 2.
+Anything else escaping to the CLI is an internal error (exit code 1).
+"""
+
+from __future__ import annotations
+
+from os import PathLike
+
+
+class KitsukeError(Exception):
+    """Base class of kitsuke's own errors."""
+
+
+class InputError(KitsukeError, ValueError):
+    """Bad input: a file or an argument that kitsuke cannot use.
+
+    Parameters
+    ----------
+    message : what is wrong, one line, without the file name.
+    path : the file (or argument) that is wrong, if there is one; it prefixes the message.
+    """
+
+    def __init__(self, message: str, path: str | PathLike[str] | None = None):
+        self.message = message
+        self.path = None if path is None else str(path)
+        super().__init__(f"{self.path}: {message}" if self.path else message)
