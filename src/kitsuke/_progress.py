@@ -9,7 +9,9 @@ from typing import TypeVar
 T = TypeVar("T")
 
 
-def progress(items: Iterable[T], *, total: int | None = None, desc: str = "", enabled: bool | None = None) -> Iterator[T]:
+def progress(
+    items: Iterable[T], *, total: int | None = None, desc: str = "", enabled: bool | None = None
+) -> Iterator[T]:
     """Iterate `items` with a tqdm bar on stderr when stderr is a terminal (or when `enabled` is True)."""
     show = sys.stderr.isatty() if enabled is None else enabled
     if not show:

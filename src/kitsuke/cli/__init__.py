@@ -61,7 +61,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
             sub.add_parser(name, help=help_text)
             continue
         mod = importlib.import_module(f".{module}", __name__)
-        mod.register(sub.add_parser(name, help=help_text, description=help_text, parser_class=_Parser))
+        mod.register(sub.add_parser(name, help=help_text, description=help_text))
     return parser
 
 
@@ -86,7 +86,10 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as e:  # noqa: BLE001 - the last line of defence: an internal error, not the user's fault
         if os.environ.get("KITSUKE_DEBUG"):
             traceback.print_exc()
-        print(f"kitsuke: internal error: {type(e).__name__}: {e} (set KITSUKE_DEBUG=1 for details)", file=sys.stderr)
+        print(
+            f"kitsuke: internal error: {type(e).__name__}: {e} (set KITSUKE_DEBUG=1 for details)",
+            file=sys.stderr,
+        )
         return 1
 
 
