@@ -98,7 +98,11 @@ def read_obj(path: str | Path) -> ObjData:
     if not verts:
         raise InputError("no vertices (is this an OBJ file?)", path)
     try:
-        vertices = np.array([r.split()[:3] for r in verts], dtype=np.float64)
+        flat = " ".join(verts).split()
+        if len(flat) == 3 * len(verts):  # the usual case: x y z only, parsed in one go
+            vertices = np.array(flat, dtype=np.float64).reshape(-1, 3)
+        else:  # some lines carry w or vertex colours
+            vertices = np.array([r.split()[:3] for r in verts], dtype=np.float64)
     except ValueError:
         raise InputError("a 'v' line does not hold three numbers", path) from None
     if vertices.ndim != 2 or vertices.shape[1] != 3:

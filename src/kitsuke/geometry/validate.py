@@ -31,8 +31,9 @@ class MeshCheck:
 def edge_topology(faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Unique undirected edges (E, 2) int64 (sorted pairs) and how many faces use each (E,) int64."""
     e = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
-    edges, counts = np.unique(e, axis=0, return_counts=True)
-    return edges, counts
+    n = int(faces.max()) + 1
+    keys, counts = np.unique(e[:, 0] * n + e[:, 1], return_counts=True)  # 1-D keys: much faster than axis=0
+    return np.stack([keys // n, keys % n], axis=1), counts
 
 
 def count_boundary_loops(boundary_edges: np.ndarray) -> int:
@@ -76,7 +77,12 @@ def clean_mesh(mesh: TriMesh, *, source: str | None = None) -> tuple[TriMesh, Me
     if len(f) == 0:
         raise InputError("every face is degenerate (zero area)", source)
     # Duplicate faces (same three vertices in any order) are dropped, keeping the first.
-    _, first = np.unique(np.sort(f, axis=1), axis=0, return_index=True)
+    sf = np.sort(f, axis=1)
+    n = len(v)
+    if n < 2_000_000:  # n**3 fits in int64: one key per face
+        _, first = np.unique((sf[:, 0] * n + sf[:, 1]) * n + sf[:, 2], return_index=True)
+    else:
+        _, first = np.unique(sf, axis=0, return_index=True)
     check.removed_duplicate_faces = len(f) - len(first)
     f = f[np.sort(first)]
     used = np.zeros(len(v), dtype=bool)
