@@ -41,11 +41,15 @@ def main() -> None:
             t = timeit(lambda p=path: load_body(p), repeat=5)
             print(f"load_body mean_all{suffix:5s} (23,752 vertices, detect + clean)  {t * 1e3:8.1f} ms")
         cm = save_mesh(type(mesh)(mesh.vertices * 100, mesh.faces), Path(tmp) / "mean_all_cm.obj")
-        print(f"load_body mean_all in cm (converted)                     {timeit(lambda: load_body(cm), 5) * 1e3:8.1f} ms")
+        print(
+            f"load_body mean_all in cm (converted)                     {timeit(lambda: load_body(cm), 5) * 1e3:8.1f} ms"
+        )
     rot = {"l_knee": [np.pi / 2, 0, 0], "r_shoulder": [0, 0, -0.6], "spine": [0.2, 0, 0]}
-    print(f"Body.pose(rotations=...) default body (LBS)              {timeit(lambda: body.pose(rotations=rot)) * 1e3:8.2f} ms")
+    t = timeit(lambda: body.pose(rotations=rot))
+    print(f"Body.pose(rotations=...) default body (LBS)              {t * 1e3:8.2f} ms")
     target = body.pose(rotations=rot).joints
-    print(f"Body.pose(positions=...) default body                    {timeit(lambda: body.pose(positions=target)) * 1e3:8.2f} ms")
+    t = timeit(lambda: body.pose(positions=target))
+    print(f"Body.pose(positions=...) default body                    {t * 1e3:8.2f} ms")
 
 
 if __name__ == "__main__":

@@ -1,0 +1,387 @@
+"""A parametric unlined kimono (hitoe) pattern from the standard measurements (data/patterns/kimono/REFERENCE.md).
+
+Construction (finished sizes, cm: the outlines are the sewing lines, no seam allowance)
+------------------------------------------------------------------------------------
+A kimono is cut from one bolt into straight rectangles. Seven pieces are made here:
+
+- **migoro_right, migoro_left** (body panels 身頃): one strip each, `shoulder` wide (katahaba, from the centre back
+  to the sleeve seam) and 2 x `length` long, running from the front hem up over the shoulder (the fold line
+  y = length) and down to the back hem. Along the centre edge: the okumi seam on the front, then the neck: a
+  diagonal from the okumi top (`okumi_drop` below the shoulder) up to the neck point on the shoulder line
+  (`neck_width` from the centre, 衿肩あき), then a short line back to the centre `back_neck_drop` below the shoulder
+  (繰越); then the back seam down to the back hem. Along the outer edge, from the front hem: side seam, underarm
+  opening (身八つ口, `underarm_opening`), sleeve attachment (袖付け, `sleeve_attachment`) up to the shoulder fold,
+  then the same three mirrored down the back.
+- **okumi_right, okumi_left** (front overlap panels 衽): `okumi_width` x (length - okumi_drop), sewn along the
+  migoro's front centre edge. The collar runs down their front edge to `collar_end` above the hem (衿先).
+- **sode_right, sode_left** (sleeves 袖): **one piece each**, `sleeve_width` wide and 2 x `sleeve_depth` long,
+  folded at the top (the sleeve crease 袖山 at y = sleeve_depth, in line with the shoulder fold), as it is cut.
+  Seams: the sleeve attachment (front and back halves to the migoro), the bottom (袖底: the two short ends), the
+  cuff side below the hand opening (袖口下, `sleeve_opening` left open from the crease down). The body side below
+  the attachment stays open (振り).
+- **eri** (collar 衿): a strip `collar_width` wide whose one long edge is sewn, left collar end to right collar end,
+  along the okumi front edge, okumi top, neck diagonal and back neck of each side; its length is their sum.
+The over-collar (tomoeri 共衿) is left out: it is a second layer on the front part of the collar and adds no shape.
+
+The fronts: the wearer's left front goes over the right (left over right), so in the placement hint the left okumi
+sits 1 cm in front of the right one.
+
+Every seam joins two edges of equal length (outlines are split where a seam covers only part of an edge) and every
+seam is `reversed` (all pieces face outwards). Edge names of every piece are in `pattern.meta["kimono"]["edges"]`.
+
+Placement hints (metres, Y up, facing +Z, feet at y = 0): a T-shape as on a kimono stand around a standing body
+of `body_height_m` (1.67 by default, the built-in body): body panels and sleeves hang from a fold over the shoulder
+line (`Fold`, a half cylinder `body_depth_m` across, so front halves lie in the plane z = centre + depth / 2 and
+back halves in z = centre - depth / 2); sleeves continue the shoulder line outwards with their crease on the same
+fold, so the attachment seams meet exactly; okumi hang in front beside the centre front; the collar hangs over the
+back of the neck, centred at the back, down the front and the back (a rough start; a wrap lays it along the
+neckline). The wearer's right is -X.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields
+
+import numpy as np
+
+from ..errors import InputError
+from ._types import EdgeRef, Fold, Pattern, Piece, Placement, Seam
+
+#: Allowed ranges, cm (a child's kimono to a tall adult's; furisode sleeves reach ~115 cm).
+RANGES = {
+    "length": (60.0, 220.0),
+    "yuki": (30.0, 95.0),
+    "shoulder": (15.0, 45.0),
+    "sleeve_depth": (20.0, 125.0),
+    "bolt_width": (28.0, 48.0),
+}
+#: Seam allowance per side assumed when checking that a piece fits the bolt, cm.
+SEAM_ALLOWANCE = 1.0
+
+
+@dataclass(frozen=True)
+class KimonoSize:
+    """Kimono measurements, finished, cm. Defaults: the standard women's size (REFERENCE.md).
+
+    The six principal measurements (the CLI options): length (身丈, shoulder to hem), yuki (裄, centre back to the
+    sleeve end = shoulder + sleeve_width), shoulder (肩幅), sleeve_width (袖幅; None: yuki - shoulder), sleeve_depth
+    (袖丈), bolt_width (反物 width; every piece must fit it with 1 cm seam allowances). The details below default
+    to None: derived from those (values for the standard size in brackets).
+    """
+
+    length: float = 158.0
+    yuki: float = 63.0
+    shoulder: float = 31.0
+    sleeve_width: float | None = None
+    sleeve_depth: float = 49.0
+    bolt_width: float = 37.0
+    sleeve_attachment: float | None = None  # 袖付け: min(23, sleeve_depth - 6)  [23]
+    underarm_opening: float | None = None  # 身八つ口: 0.09 x length  [14.2]
+    sleeve_opening: float | None = None  # 袖口: min(23, sleeve_depth - 4)  [23]
+    okumi_width: float | None = None  # 衽幅: bolt_width / 2 - 3.5  [15]
+    okumi_drop: float | None = None  # 衽下がり, shoulder to okumi top: 23 x length / 158  [23]
+    collar_end: float | None = None  # 衿下, hem to collar end: 0.48 x length  [75.8]
+    collar_width: float = 5.5  # 衿幅
+    neck_width: float = 9.0  # 衿肩あき, centre to the neck point on the shoulder
+    back_neck_drop: float = 2.0  # 繰越
+
+    def resolved(self) -> KimonoSize:
+        """All derived values filled in, after checking every number; InputError names the bad option."""
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if v is not None and (isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v)):
+                raise InputError(f"{_opt(f.name)} must be a finite number of centimetres, got {v!r}", _opt(f.name))
+        for name, (lo, hi) in RANGES.items():
+            v = getattr(self, name)
+            if not lo <= v <= hi:
+                raise InputError(f"{name.replace('_', ' ')} {v:g} cm is outside {lo:g}..{hi:g} cm", _opt(name))
+        if self.yuki <= self.shoulder:
+            raise InputError(
+                f"yuki ({self.yuki:g} cm) must exceed the shoulder width ({self.shoulder:g} cm): yuki is "
+                "the shoulder width plus the sleeve width",
+                "--yuki",
+            )
+        sw = self.yuki - self.shoulder if self.sleeve_width is None else float(self.sleeve_width)
+        if self.sleeve_width is not None and abs(self.shoulder + sw - self.yuki) > 0.5:
+            raise InputError(
+                f"yuki ({self.yuki:g}) must equal shoulder ({self.shoulder:g}) + sleeve width ({sw:g}) "
+                "cm; give two of the three",
+                "--sleeve-width",
+            )
+        usable = self.bolt_width - 2 * SEAM_ALLOWANCE
+        for name, v in (("sleeve_width", sw), ("shoulder", self.shoulder)):
+            if not 10.0 <= v <= usable:
+                raise InputError(
+                    f"{name.replace('_', ' ')} {v:g} cm does not fit the bolt width {self.bolt_width:g} "
+                    f"cm (10..{usable:g} cm with {SEAM_ALLOWANCE:g} cm seam allowances)",
+                    _opt(name),
+                )
+        d = self.sleeve_depth
+        att = min(23.0, d - 6.0) if self.sleeve_attachment is None else self.sleeve_attachment
+        hand = min(23.0, d - 4.0) if self.sleeve_opening is None else self.sleeve_opening
+        under = 0.09 * self.length if self.underarm_opening is None else self.underarm_opening
+        okw = self.bolt_width / 2 - 3.5 if self.okumi_width is None else self.okumi_width
+        drop = 23.0 * self.length / 158.0 if self.okumi_drop is None else self.okumi_drop
+        cend = 0.48 * self.length if self.collar_end is None else self.collar_end
+        out = KimonoSize(
+            self.length,
+            self.yuki,
+            self.shoulder,
+            sw,
+            d,
+            self.bolt_width,
+            att,
+            under,
+            hand,
+            okw,
+            drop,
+            cend,
+            self.collar_width,
+            self.neck_width,
+            self.back_neck_drop,
+        )
+        checks = [
+            (
+                0 < att <= d - 3,
+                "sleeve_attachment",
+                f"must be positive and at least 3 cm short of the sleeve depth {d:g}",
+            ),
+            (
+                0 < hand <= d - 3,
+                "sleeve_opening",
+                f"must be positive and at least 3 cm short of the sleeve depth {d:g}",
+            ),
+            (
+                0 < under and att + under <= 0.6 * self.length,
+                "underarm_opening",
+                "with the sleeve attachment must stay within 60 % of the length",
+            ),
+            (4 <= okw <= self.bolt_width / 2, "okumi_width", f"must be 4..{self.bolt_width / 2:g} cm (half the bolt)"),
+            (5 <= drop <= 0.4 * self.length, "okumi_drop", "must be 5 cm .. 40 % of the length"),
+            (0 <= cend < self.length - drop - 5, "collar_end", "must leave at least 5 cm of collar on the okumi"),
+            (2 <= self.collar_width <= self.bolt_width / 2, "collar_width", "must be 2 cm .. half the bolt width"),
+            (2 <= self.neck_width <= self.shoulder - 5, "neck_width", "must be 2 cm .. the shoulder width - 5"),
+            (0 <= self.back_neck_drop <= 8, "back_neck_drop", "must be 0..8 cm"),
+        ]
+        for ok, name, why in checks:
+            if not ok:
+                raise InputError(f"{name.replace('_', ' ')} {getattr(out, name):g} cm {why}", _opt(name))
+        return out
+
+    def label(self) -> str:
+        """Short description, e.g. 'kimono 158/63/31/49' (length/yuki/shoulder/sleeve depth)."""
+        return f"kimono {self.length:g}/{self.yuki:g}/{self.shoulder:g}/{self.sleeve_depth:g}"
+
+
+def _opt(name: str) -> str:
+    return "--" + name.replace("_", "-")
+
+
+def _piece(name: str, pts: list, edge_names: list[str], placement: Placement) -> tuple[Piece, dict[str, int]]:
+    return Piece(name, np.array(pts, dtype=np.float64), {}, False, placement), {n: i for i, n in enumerate(edge_names)}
+
+
+def make_kimono(
+    size: KimonoSize | None = None,
+    *,
+    body_height_m: float = 1.67,
+    body_center_z_m: float = 0.03,
+    body_depth_m: float = 0.34,
+) -> Pattern:
+    """The kimono pattern for `size` (default: the standard size) with its seams and placement hints.
+
+    body_height_m, body_center_z_m, body_depth_m : the standing body the placement hints are made for (feet at
+        y = 0, facing +Z): its height, the z of its torso's centre and the front-to-back depth the fold wraps.
+    """
+    s = (size or KimonoSize()).resolved()
+    L, K, W, D = s.length, s.shoulder, s.sleeve_width, s.sleeve_depth
+    a, u, c = s.sleeve_attachment, s.underarm_opening, s.sleeve_opening
+    n, k, sd, O, H = s.neck_width, s.back_neck_drop, s.okumi_drop, s.okumi_width, s.length - s.okumi_drop
+    E = s.collar_end
+    # Placement: the shoulder line (top of the fold) at 0.84 body height; the fold's half-cylinder spans the depth.
+    r = 50.0 * body_depth_m  # fold radius, cm
+    shoulder_y = 0.84 * body_height_m
+    zf = body_center_z_m + body_depth_m / 2  # front plane, m
+    # With the fold, the fold line y_f ends up at local height y_f - (pi/2 - 1) r: lift by that much.
+    lift = (math.pi / 2 - 1) * r / 100.0
+
+    def hang(x_m: float, fold_y_cm: float, z_m: float = zf, fold: bool = True) -> Placement:
+        y0 = shoulder_y - fold_y_cm / 100.0 + (lift if fold else 0.0)
+        return Placement([x_m, y0, z_m], [0, 0, 0], Fold(fold_y_cm, 2 * r) if fold else None)
+
+    pieces, edges = [], {}
+
+    def add(name, pts, names, placement):
+        piece, e = _piece(name, pts, names, placement)
+        pieces.append(piece)
+        edges[name] = e
+
+    # Right body panel: side at x = 0 (world x = -K), centre at x = K (world 0).
+    add(
+        "migoro_right",
+        [
+            (0, 0),
+            (K, 0),
+            (K, L - sd),
+            (K - n, L),
+            (K, L + k),
+            (K, 2 * L),
+            (0, 2 * L),
+            (0, L + a + u),
+            (0, L + a),
+            (0, L),
+            (0, L - a),
+            (0, L - a - u),
+        ],
+        [
+            "front_hem",
+            "front_centre",
+            "front_neck",
+            "back_neck",
+            "back_centre",
+            "back_hem",
+            "back_side",
+            "back_underarm",
+            "back_sleeve",
+            "front_sleeve",
+            "front_underarm",
+            "front_side",
+        ],
+        hang(-K / 100.0, L),
+    )
+    add(
+        "migoro_left",
+        [
+            (0, 0),
+            (K, 0),
+            (K, L - a - u),
+            (K, L - a),
+            (K, L),
+            (K, L + a),
+            (K, L + a + u),
+            (K, 2 * L),
+            (0, 2 * L),
+            (0, L + k),
+            (n, L),
+            (0, L - sd),
+        ],
+        [
+            "front_hem",
+            "front_side",
+            "front_underarm",
+            "front_sleeve",
+            "back_sleeve",
+            "back_underarm",
+            "back_side",
+            "back_hem",
+            "back_centre",
+            "back_neck",
+            "front_neck",
+            "front_centre",
+        ],
+        hang(0.0, L),
+    )
+    # Okumi: the right one lies over the left body panel's front (under the left okumi), 1 cm behind it.
+    add(
+        "okumi_right",
+        [(0, 0), (O, 0), (O, E), (O, H), (0, H)],
+        ["hem", "front_free", "front_collar", "top", "centre"],
+        Placement([0.0, shoulder_y + lift - L / 100.0, zf + 0.005], [0, 0, 0]),
+    )
+    add(
+        "okumi_left",
+        [(0, 0), (O, 0), (O, H), (0, H), (0, E)],
+        ["hem", "centre", "top", "front_collar", "front_free"],
+        Placement([-O / 100.0, shoulder_y + lift - L / 100.0, zf + 0.015], [0, 0, 0]),
+    )
+    # Sleeves: one folded piece each, crease at y = D on the shoulder fold; body side towards the body panel.
+    add(
+        "sode_right",
+        [(0, 0), (W, 0), (W, D - a), (W, D), (W, D + a), (W, 2 * D), (0, 2 * D), (0, D + c), (0, D), (0, D - c)],
+        [
+            "front_bottom",
+            "front_furi",
+            "front_attach",
+            "back_attach",
+            "back_furi",
+            "back_bottom",
+            "back_cuff_seam",
+            "back_opening",
+            "front_opening",
+            "front_cuff_seam",
+        ],
+        hang(-(K + W) / 100.0, D),
+    )
+    add(
+        "sode_left",
+        [(0, 0), (W, 0), (W, D - c), (W, D), (W, D + c), (W, 2 * D), (0, 2 * D), (0, D + a), (0, D), (0, D - a)],
+        [
+            "front_bottom",
+            "front_cuff_seam",
+            "front_opening",
+            "back_opening",
+            "back_cuff_seam",
+            "back_bottom",
+            "back_furi",
+            "back_attach",
+            "front_attach",
+            "front_furi",
+        ],
+        hang(K / 100.0, D),
+    )
+    # Collar: its bottom edge (y = 0), left collar end (x = 0) to right collar end, is sewn segment by segment.
+    diag, bneck, upper = math.hypot(n, sd), math.hypot(n, k), H - E
+    segs = [
+        ("left_okumi_front", upper),
+        ("left_okumi_top", O),
+        ("left_front_neck", diag),
+        ("left_back_neck", bneck),
+        ("right_back_neck", bneck),
+        ("right_front_neck", diag),
+        ("right_okumi_top", O),
+        ("right_okumi_front", upper),
+    ]
+    xs = np.concatenate([[0.0], np.cumsum([v for _, v in segs])])
+    Lc, e = float(xs[-1]), s.collar_width
+    # Upright strip: the sewn side is x = e, walked upwards from the left collar end (y = 0) to the right one.
+    collar_pts = [(e, float(y)) for y in xs[:-1]] + [(e, Lc), (0.0, Lc), (0.0, 0.0)]
+    collar_names = [nm for nm, _ in segs] + ["right_end", "outer", "left_end"]
+    # Hint (rough): folded at its middle over the back of the neck, the left half down the left okumi's front
+    # edge (its sewn side on that edge), the right half down the centre back.
+    add(
+        "eri",
+        collar_pts,
+        collar_names,
+        Placement(
+            [-(O + e) / 100.0, shoulder_y + lift + 0.01 - Lc / 200.0, zf + 0.025], [0, 0, 0], Fold(Lc / 2, 2 * r + 5.0)
+        ),
+    )
+
+    def seam(pa, ea, pb, eb):
+        return Seam(EdgeRef(pa, edges[pa][ea]), EdgeRef(pb, edges[pb][eb]), True)
+
+    seams = [
+        seam("migoro_right", "back_centre", "migoro_left", "back_centre"),
+        seam("migoro_right", "front_side", "migoro_right", "back_side"),
+        seam("migoro_left", "front_side", "migoro_left", "back_side"),
+        seam("okumi_right", "centre", "migoro_right", "front_centre"),
+        seam("okumi_left", "centre", "migoro_left", "front_centre"),
+    ]
+    for side in ("right", "left"):
+        sode, mig = f"sode_{side}", f"migoro_{side}"
+        seams += [
+            seam(sode, "front_attach", mig, "front_sleeve"),
+            seam(sode, "back_attach", mig, "back_sleeve"),
+            seam(sode, "front_bottom", sode, "back_bottom"),
+            seam(sode, "front_cuff_seam", sode, "back_cuff_seam"),
+        ]
+    for side in ("left", "right"):
+        seams += [
+            seam("eri", f"{side}_okumi_front", f"okumi_{side}", "front_collar"),
+            seam("eri", f"{side}_okumi_top", f"okumi_{side}", "top"),
+            seam("eri", f"{side}_front_neck", f"migoro_{side}", "front_neck"),
+            seam("eri", f"{side}_back_neck", f"migoro_{side}", "back_neck"),
+        ]
+    meta = {"kimono": {"size": asdict(s), "label": s.label(), "edges": edges}}
+    return Pattern("kimono", pieces, seams, meta)

@@ -1,0 +1,110 @@
+"""The parametric kimono: requested dimensions, equal seams, consistent placement hints, validated measurements."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from kitsuke.errors import InputError
+from kitsuke.pattern import KimonoSize, make_kimono, validate
+
+
+def size_of(pattern, name):
+    return pytest.approx(tuple(np.ptp(pattern.piece(name).bounds, axis=0)), abs=1e-9)
+
+
+def test_standard_kimono(kimono):
+    assert validate(kimono) == []
+    assert sorted(p.name for p in kimono.pieces) == sorted(
+        ["migoro_right", "migoro_left", "okumi_right", "okumi_left", "sode_right", "sode_left", "eri"]
+    )
+    assert len(kimono.seams) == 21
+    s = kimono.meta["kimono"]["size"]
+    assert s["sleeve_width"] == 32.0 and s["shoulder"] + s["sleeve_width"] == s["yuki"] == 63.0
+
+
+@pytest.mark.parametrize(
+    "size", [KimonoSize(), KimonoSize(length=150, yuki=68, shoulder=32, sleeve_depth=110, bolt_width=38)]
+)
+def test_pieces_have_the_requested_dimensions(size):
+    p = make_kimono(size)
+    s = size.resolved()
+    for side in ("right", "left"):
+        assert size_of(p, f"migoro_{side}") == (s.shoulder, 2 * s.length)  # front and back over the shoulder
+        assert size_of(p, f"sode_{side}") == (s.sleeve_width, 2 * s.sleeve_depth)  # one piece, folded
+        assert size_of(p, f"okumi_{side}") == (s.okumi_width, s.length - s.okumi_drop)
+    assert s.shoulder + s.sleeve_width == pytest.approx(s.yuki)
+    eri = p.piece("eri")
+    assert np.ptp(eri.bounds, axis=0)[0] == pytest.approx(s.collar_width)
+    edges = p.meta["kimono"]["edges"]
+    # Sleeve attachment and underarm opening along the body panel's side edge.
+    mig = p.piece("migoro_right")
+    assert mig.edge_length(edges["migoro_right"]["front_sleeve"]) == pytest.approx(s.sleeve_attachment)
+    assert mig.edge_length(edges["migoro_right"]["front_underarm"]) == pytest.approx(s.underarm_opening)
+    sode = p.piece("sode_left")
+    assert sode.edge_length(edges["sode_left"]["front_opening"]) == pytest.approx(s.sleeve_opening)
+    # The collar is exactly as long as the neckline it is sewn to.
+    sewn = [q for q in p.seams if q.a.piece == "eri"]
+    assert len(sewn) == 8
+    assert sum(p.edge_length(q.b) for q in sewn) == pytest.approx(eri.bounds[1, 1])
+    # Every seam joins equal lengths.
+    for q in p.seams:
+        assert p.edge_length(q.a) == pytest.approx(p.edge_length(q.b), abs=1e-9)
+
+
+def test_placement_hints_close_the_seams_that_should_meet(kimono):
+    """Seams between pieces hanging on the same fold meet exactly in 3D with the `reversed` pairing."""
+    gaps = {}
+    for i, s in enumerate(kimono.seams):
+        a = kimono.piece(s.a.piece)
+        b = kimono.piece(s.b.piece)
+        pa = a.placement.apply(a.resample_edge(s.a.edge, 8))
+        pb = b.placement.apply(b.resample_edge(s.b.edge, 8))
+        gaps[i] = np.linalg.norm(pa - (pb[::-1] if s.reversed else pb), axis=1).max()
+        # For every seam but the collar's (its hint is rough) the chosen pairing is the nearer one.
+        other = np.linalg.norm(pa - (pb if s.reversed else pb[::-1]), axis=1).max()
+        assert s.a.piece == "eri" or gaps[i] < other
+    names = {i: (s.a.piece, s.b.piece) for i, s in enumerate(kimono.seams)}
+    closed = [i for i, (x, y) in names.items() if {x, y} <= {"migoro_right", "migoro_left"} and x != y]
+    closed += [i for i, (x, y) in names.items() if x.startswith("sode") and y.startswith("migoro")]
+    assert len(closed) == 5  # back seam and the four sleeve attachments
+    for i in closed:
+        assert gaps[i] < 1e-9
+    # Front halves in front of the body, back halves behind it; the shoulder line at 0.84 x 1.67 m.
+    mig = kimono.piece("migoro_right")
+    front = mig.placement.apply(np.array([[10.0, 20.0]]))[0]
+    back = mig.placement.apply(np.array([[10.0, 296.0]]))[0]
+    assert front[2] > 0.1 and back[2] < -0.05 and front[1] == pytest.approx(back[1])
+    top = mig.placement.apply(mig.polygon())[:, 1].max()
+    assert top == pytest.approx(0.84 * 1.67, abs=1e-9)
+    assert mig.placement.apply(np.array([[0.0, 100.0]]))[0, 0] == pytest.approx(-0.31)  # right side at -X
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "option", "text"),
+    [
+        ({"yuki": 30}, "--yuki", "must exceed the shoulder width"),
+        ({"length": 500}, "--length", "outside 60..220"),
+        ({"length": math.nan}, "--length", "finite"),
+        ({"sleeve_width": 20}, "--sleeve-width", "must equal shoulder"),
+        ({"yuki": 70, "shoulder": 31, "bolt_width": 36}, "--sleeve-width", "does not fit the bolt width"),
+        ({"shoulder": 40, "yuki": 72}, "--shoulder", "does not fit the bolt width"),
+        ({"sleeve_depth": 22}, "--sleeve-attachment", None),
+    ],
+)
+def test_bad_measurements(kwargs, option, text):
+    if text is None:  # a short sleeve shortens the derived attachment instead of failing
+        assert make_kimono(KimonoSize(**kwargs)).meta["kimono"]["size"]["sleeve_attachment"] == 16.0
+        return
+    with pytest.raises(InputError) as err:
+        make_kimono(KimonoSize(**kwargs))
+    assert err.value.path == option and text in err.value.message
+
+
+def test_cli_defaults_match_the_library():
+    from kitsuke.cli.pattern import KIMONO_DEFAULTS
+
+    d = KimonoSize()
+    assert KIMONO_DEFAULTS == {k: getattr(d, k) for k in KIMONO_DEFAULTS}

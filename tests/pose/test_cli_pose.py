@@ -1,0 +1,93 @@
+"""`kitsuke pose extract|correct` end to end: files, summary, plot, overlay video, and bad input (exit 2)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from kitsuke.pose import read_poses
+
+from .conftest import BALANCING, KICK
+
+
+@pytest.fixture(scope="module")
+def extracted(tmp_path_factory):
+    from kitsuke.cli import main
+
+    out = tmp_path_factory.mktemp("cli") / "poses.json"
+    assert main(["pose", "extract", str(BALANCING), "-o", str(out), "--stride", "3"]) == 0
+    return out
+
+
+def test_extract_writes_a_filtered_sequence(extracted):
+    s = read_poses(extracted)
+    assert s.n_frames == 34 and s.valid.all() and s.fps == 20
+    assert s.source["kind"] == "video" and s.source["filter"]["min_cutoff_hz"] == 1.0
+    assert s.image is not None and s.source["size"] == [1080, 1920]
+
+
+def test_correct_with_plot_video_and_summary(extracted, tmp_path, run_cli):
+    out, png, mp4, summ = tmp_path / "c.json", tmp_path / "legs.png", tmp_path / "overlay.mp4", tmp_path / "s.json"
+    r = run_cli("pose", "correct", extracted, "-o", out, "--plot", png, "--video", mp4, "--summary", summ)
+    assert r.code == 0, r.err
+    summary = json.loads(r.out)
+    assert summary == json.loads(summ.read_text())
+    assert summary["corrected_frames"] > 5 and summary["invariants"]["ok"] and summary["residual_mm"]["max"] == 0
+    c = read_poses(out)
+    assert c.raw_positions is not None and any(c.corrected) and c.constraints.source == "geometric estimate"
+    with Image.open(png) as im:
+        assert im.size[0] > 800 and np.asarray(im.convert("L")).std() > 10
+    import imageio_ffmpeg
+
+    reader = imageio_ffmpeg.read_frames(str(mp4))
+    meta = next(reader)
+    frames = list(reader)
+    assert meta["codec"] == "h264" and meta["size"] == (720, 1280) and len(frames) == c.n_frames
+    assert meta["fps"] == pytest.approx(20)
+
+
+def test_correct_bvh_draws_synthetic_views(tmp_path, run_cli):
+    out, mp4 = tmp_path / "k.json", tmp_path / "k.mp4"
+    r = run_cli("pose", "correct", KICK, "-o", out, "--video", mp4, "--max-frames", "60", "--stride", "3")
+    assert r.code == 0, r.err
+    import imageio_ffmpeg
+
+    reader = imageio_ffmpeg.read_frames(str(mp4))
+    meta = next(reader)
+    assert meta["codec"] == "h264" and meta["size"] == (960, 540) and len(list(reader)) == 60
+
+
+def test_bad_inputs_exit_2_with_one_line(tmp_path, extracted, run_cli):
+    before = extracted.read_bytes()
+    cases = [
+        (["pose", "correct", tmp_path / "missing.mp4", "-o", tmp_path / "o.json"], "missing.mp4: not found"),
+        (["pose", "correct", extracted, "-o", extracted], "refusing to overwrite an input"),
+        (["pose", "correct", extracted, "-o", tmp_path / "o.json", "--plot", tmp_path / "p.jpg"], "must be a .png"),
+        (["pose", "extract", "-o", tmp_path / "o.json"], "give either SOURCE or --camera"),
+        (["pose", "extract", extracted, "--camera", "0", "-o", tmp_path / "o.json"], "give either SOURCE"),
+        (["pose", "extract", "--camera", "57", "-o", tmp_path / "o.json"], "camera 57: cannot open the camera"),
+        (["pose", "extract", extracted, "-o", tmp_path / "o.json", "--stride", "0"], "--stride must be at least 1"),
+    ]
+    for args, message in cases:
+        r = run_cli(*args)
+        assert r.code == 2, (args, r.err)
+        assert message in r.err and r.err.count("\n") == 1 and "Traceback" not in r.err
+    assert not (tmp_path / "o.json").exists() and extracted.read_bytes() == before
+
+
+def test_help_and_a_real_process(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "kitsuke", "pose", "correct", "--help"], capture_output=True, text=True)
+    assert r.returncode == 0
+    for word in ("examples:", "--constraints", "--plot", "--video", "H.264", "E(θ)", "--no-filter", "Hz"):
+        assert word in r.stdout
+    out = tmp_path / "kick.json"
+    r = subprocess.run(
+        [sys.executable, "-m", "kitsuke", "pose", "correct", str(KICK), "-o", str(out)], capture_output=True, text=True
+    )
+    assert r.returncode == 0 and r.stderr == ""  # quiet when not on a terminal
+    assert json.loads(r.stdout)["corrections"]["knee"] > 30 and read_poses(out).n_frames == 201

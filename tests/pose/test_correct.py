@@ -1,0 +1,211 @@
+"""Posture correction (SPEC §5.3): invariants on synthetic and real poses, kernel vs numpy reference, measures."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from kitsuke.pose import (
+    PoseSequence,
+    check_invariants,
+    correct_poses,
+    correction_measures,
+    default_constraints,
+    filter_poses,
+)
+from kitsuke.pose import _kernels as K
+from kitsuke.pose._correct import inside_values, regions_of
+from kitsuke.pose._reference import correct_reference
+from kitsuke.skeleton import INDEX, JOINTS
+
+TABLE = default_constraints()
+
+
+def standing_pose() -> np.ndarray:
+    """(23, 3) a person standing, metres, Y up, facing +Z, left at +X."""
+    p = {
+        "pelvis": (0, 0.95, 0),
+        "spine": (0, 1.1, 0),
+        "chest": (0, 1.3, 0),
+        "neck": (0, 1.45, 0),
+        "head": (0, 1.6, 0.02),
+        "l_clavicle": (0.03, 1.42, 0.03),
+        "l_shoulder": (0.18, 1.42, 0),
+        "l_elbow": (0.2, 1.15, 0),
+        "l_wrist": (0.2, 0.9, 0.05),
+        "l_hip": (0.09, 0.92, 0),
+        "l_knee": (0.1, 0.5, 0.02),
+        "l_ankle": (0.1, 0.08, 0),
+        "l_heel": (0.1, 0.02, -0.05),
+        "l_toe": (0.1, 0.02, 0.15),
+    }
+    out = np.zeros((len(JOINTS), 3))
+    for name, xyz in p.items():
+        out[INDEX[name]] = xyz
+        if name.startswith("l_"):
+            out[INDEX["r" + name[1:]]] = (-xyz[0], xyz[1], xyz[2])
+    return out
+
+
+def raise_leg(pose: np.ndarray, side: str, axis: str, deg: float) -> np.ndarray:
+    """The pose with one leg rotated at the hip (axis 'z': sideways, 'x': forward)."""
+    q = pose.copy()
+    hip = INDEX[f"{side}_hip"]
+    idx = [INDEX[f"{side}_{j}"] for j in ("knee", "ankle", "heel", "toe")]
+    sign = -1.0 if (side == "r") == (axis == "z") else 1.0
+    rot = Rotation.from_euler(axis, sign * deg, degrees=True)
+    if axis == "x":
+        rot = Rotation.from_euler("x", -deg, degrees=True)  # knee forward (+Z)
+    q[idx] = q[hip] + rot.apply(q[idx] - q[hip])
+    return q
+
+
+def seq(frames: list[np.ndarray], valid: list[bool] | None = None) -> PoseSequence:
+    pos = np.array(frames)
+    v = np.ones(len(pos), bool) if valid is None else np.array(valid)
+    return PoseSequence(positions=pos, valid=v, times=np.arange(len(pos)) / 30.0, fps=30.0)
+
+
+def test_pose_inside_is_left_bit_identical():
+    s = seq([standing_pose()] * 3)
+    c = correct_poses(s)
+    assert np.array_equal(c.poses.positions, s.positions)
+    assert (c.status == K.INSIDE).all() and c.poses.corrected == [(), (), ()]
+
+
+def test_side_raise_is_corrected_into_k_with_smallest_angle():
+    raised = raise_leg(standing_pose(), "r", "z", 40)  # right leg out to the side, knee 0.46 m from the left one
+    c = correct_poses(seq([raised]))
+    q = c.poses.positions[0]
+    assert c.poses.corrected[0][0] == "r_knee" and c.status[0, 0] == K.ROTATED
+    # first frame: K' is the current K; the corrected knee is inside it (and within 0.1 mm of its edge)
+    ell, excess = regions_of(raised[None], TABLE, "knee")
+    assert excess[0] > 0.1
+    assert inside_values(q[None, INDEX["r_knee"], ::2], ell)[0] <= 0
+    # the knee came down and in (rotation toward the kimono's region), bones kept their lengths
+    assert q[INDEX["r_knee"], 0] > raised[INDEX["r_knee"], 0] and q[INDEX["r_knee"], 1] < raised[INDEX["r_knee"], 1]
+    for a, b in (("r_hip", "r_knee"), ("r_knee", "r_ankle"), ("r_ankle", "r_toe"), ("r_ankle", "r_heel")):
+        la = np.linalg.norm(q[INDEX[b]] - q[INDEX[a]])
+        assert abs(la - np.linalg.norm(raised[INDEX[b]] - raised[INDEX[a]])) < 1e-12
+    # smallest angle: no smaller rotation about the same axis reaches inside (up to the 0.1 mm tolerance)
+    s = raised[INDEX["r_knee"]] - raised[INDEX["r_hip"]]
+    w = q[INDEX["r_knee"]] - raised[INDEX["r_knee"]]
+    e = np.cross(s, w)
+    e /= np.linalg.norm(e)
+    angle = c.angle_rad[0, 0]
+    alphas = np.linspace(0, angle - 1e-4 / np.linalg.norm(s), 2000)
+    pts = raised[INDEX["r_hip"]] + Rotation.from_rotvec(alphas[:, None] * e).apply(s)
+    assert (inside_values(pts[:, ::2], np.repeat(ell, len(alphas), 0)) > 0).all()
+
+
+def test_previous_corrected_frame_gives_k_prime_and_gaps_restart():
+    stand = standing_pose()
+    frames = [
+        stand,
+        raise_leg(stand, "r", "z", 35),
+        raise_leg(stand, "r", "z", 40),
+        stand,
+        raise_leg(stand, "r", "z", 40),
+    ]
+    c = correct_poses(seq(frames, [True, True, True, False, True]))
+    q = c.poses.positions
+    # frame 2's K' is K of the corrected frame 1
+    assert np.allclose(c.regions[2, 0], regions_of(q[1:2], TABLE, "knee")[0][0], atol=1e-12)
+    # frame 4 follows a frame without a pose: its K' is its own current K
+    assert np.allclose(c.regions[4, 0], regions_of(np.array(frames[4:5]), TABLE, "knee")[0][0], atol=1e-12)
+    assert check_invariants(c)["ok"]
+
+
+def test_gradual_side_raise_keeps_every_invariant():
+    stand = standing_pose()
+    degs = np.concatenate([np.linspace(0, 60, 40), np.linspace(60, 0, 40)])
+    c = correct_poses(seq([raise_leg(stand, "r", "z", d) for d in degs]))
+    inv = check_invariants(c)
+    assert inv["ok"], inv
+    assert inv["continuity_checked"] > 20
+    rot = c.rotated[:, 0]
+    assert rot.sum() > 30 and not rot[:5].any()  # the small raises stay untouched
+    assert correction_measures(c)["residual_mm"]["max"] == 0.0
+
+
+def test_out_of_reach_is_reported_not_crashed():
+    stand = standing_pose()
+    far = raise_leg(stand, "r", "z", 50) + np.array([1.5, 0.0, 0.0])  # the whole body jumped 1.5 m sideways
+    c = correct_poses(seq([stand, far]))
+    assert c.status[1, 0] in (K.CLOSEST, K.UNREACHABLE) and c.residual_m[1, 0] > 0
+    inv = check_invariants(c)
+    assert inv["unreachable"] >= 1 and inv["lengths_changed"] == 0 and inv["untouched_changed"] == 0
+
+
+def test_numba_kernel_matches_numpy_reference(balancing_raw, kick):
+    for poses in (balancing_raw, kick.subset(slice(120, 200))):
+        c = correct_poses(poses)
+        ref, targets = correct_reference(poses.positions, poses.valid, TABLE)
+        v = poses.valid
+        assert np.array_equal(np.where(c.rotated, c.target, -1), targets)
+        # where the smallest angle is bracketed and bisected, both give the same result to 1e-7 m (the closest
+        # ellipse point, hence the axis, is computed differently); out-of-reach targets (golden section vs scipy's
+        # bounded minimiser) agree to the 0.1 mm tolerance, and the difference fades over the following frames
+        closest = np.flatnonzero((c.status == K.CLOSEST).any(axis=1))
+        first = closest[0] if len(closest) else len(v)
+        assert np.abs(c.poses.positions[:first][v[:first]] - ref[:first][v[:first]]).max() < 1e-7
+        assert np.abs(c.poses.positions[v] - ref[v]).max() < 1e-3
+
+
+@pytest.mark.parametrize("which", ["balancing", "balancing_filtered", "kick"])
+def test_real_sequences_keep_all_invariants(which, balancing_raw, kick):
+    poses = {"balancing": balancing_raw, "balancing_filtered": filter_poses(balancing_raw), "kick": kick}[which]
+    c = correct_poses(poses)
+    inv = check_invariants(c)
+    assert inv["ok"], inv
+    assert inv["max_length_change_m"] < 1e-9
+    m = correction_measures(c)
+    if which.startswith("balancing"):
+        # large leg raises: frames must be corrected there, knees and ankles
+        assert m["fraction_corrected"] > 0.3 and m["corrections"]["knee"] > 10 and m["corrections"]["ankle"] > 10
+        assert m["residual_mm"]["max"] == 0.0
+    else:
+        assert m["corrections"]["knee"] > 30  # the kick
+        assert inv["unreachable"] <= 10
+
+
+def test_walk_invariants(walk):
+    """CMU 131 walk (994 frames @120 fps): untouched frames, targets inside K', bone lengths hold exactly. The
+    SPEC's continuity bound does not hold everywhere for the SPEC's own algorithm (the rotation about the hip moves
+    the knee along a circle that can cross the moving cylinder faster than either moves); on this clip 20 of 1177
+    checked targets break it by at most 16 mm. Asserted as measured, so that a regression shows."""
+    c = correct_poses(walk)
+    inv = check_invariants(c)
+    assert inv["untouched_changed"] == 0 and inv["targets_outside"] == 0 and inv["lengths_changed"] == 0
+    assert inv["continuity_broken"] <= 0.02 * inv["continuity_checked"]
+    assert inv["worst_continuity_excess_m"] < 0.02
+    m = correction_measures(c)
+    assert 0.5 < m["fraction_corrected"] < 0.95 and m["time_per_frame_ms"] >= 0
+
+
+def test_file_round_trip_keeps_invariants(tmp_path, balancing_raw):
+    from kitsuke.pose import read_poses, write_poses
+
+    c = correct_poses(balancing_raw)
+    back = read_poses(write_poses(c.poses, tmp_path / "c.json"))
+    untouched = np.array([not t for t in back.corrected])
+    assert np.array_equal(back.positions[untouched & back.valid], balancing_raw.positions[untouched & back.valid])
+    assert np.array_equal(back.positions, c.poses.positions, equal_nan=True)
+
+
+def test_measures_content(balancing_raw):
+    m = correction_measures(correct_poses(balancing_raw))
+    assert set(m) >= {"fraction_corrected", "residual_mm", "max_jump_m", "invariants", "time_per_frame_ms"}
+    assert set(m["max_jump_m"]) == {f"{s}_{j}" for s in "lr" for j in ("knee", "ankle", "heel", "toe")}
+    assert math.isclose(m["fraction_corrected"], m["corrected_frames"] / m["valid_frames"], rel_tol=1e-5)
+
+
+def test_invalid_frames_pass_through():
+    stand = standing_pose()
+    s = seq([stand, stand, raise_leg(stand, "r", "z", 45)], [True, False, True])
+    c = correct_poses(s)
+    assert np.isnan(c.poses.positions[1]).all() and (c.status[1] == K.INVALID).all()
+    assert c.rotated[2, 0]
