@@ -33,6 +33,8 @@ examples:
   kitsuke pattern convert shirt_spec.json shirt.svg
   kitsuke pattern mesh kimono.json -o kimono.obj
   kitsuke render body.glb -o front.png --view front
+  kitsuke pose extract clip.mp4 -o poses.json    # MediaPipe, bundled model; also BVH, images, --camera 0
+  kitsuke pose correct clip.mp4 -o fixed.json --plot legs.png --video overlay.mp4
 
 Run `kitsuke <group> --help` for a group's verbs and options.
 """

@@ -5,7 +5,9 @@ For each frame, in order, knees first and then ankles (on the knee-corrected pos
    a = E(θ)/2, semi-minor b = A/(π a). If the pair's horizontal distance is within E(θ) the frame is left exactly as
    it is (for this pair).
 2. Otherwise the target is the joint of the pair farther (horizontally) from the pelvis. K' is K of the previous
-   frame's *corrected* pose (the current K on the first frame or after a frame without a pose).
+   frame's *corrected* pose (the current K on the first frame or after a frame without a pose). Where the SPEC is
+   silent: if that joint is already inside K' but the other is not, the other is the target — rotating a joint that
+   is already inside does nothing, and the pair would stay apart (a one-frame spike in the plots).
 3. The segment above the target (thigh for a knee, shin for an ankle) and everything below it rotate about the
    axis e = normalise(segment × w) through the segment's start (hip, knee), w being the horizontal direction from
    the target toward its closest point on K''s ellipse (up × w when the segment is parallel to w), by the smallest
@@ -58,7 +60,7 @@ STATUS = {
     K.INVALID: "no pose",
     K.INSIDE: "inside K",
     K.ROTATED: "rotated into K'",
-    K.ALREADY_INSIDE: "target already inside K'",
+    K.ALREADY_INSIDE: "both joints already inside K'",
     K.CLOSEST: "rotated to the closest angle (K' out of reach)",
     K.UNREACHABLE: "K' out of reach, not rotated",
 }

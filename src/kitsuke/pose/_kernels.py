@@ -16,7 +16,7 @@ from numba import njit
 # status codes per frame and pair
 INSIDE = 0  # pair inside K: frame untouched for this pair
 ROTATED = 1  # target rotated into K'
-ALREADY_INSIDE = 2  # pair outside K but the target already inside K': nothing to rotate
+ALREADY_INSIDE = 2  # pair outside K but both joints already inside K': nothing to rotate
 CLOSEST = 3  # no angle reaches inside K': rotated to the closest angle
 UNREACHABLE = 4  # no angle gets closer than the current pose: not rotated
 INVALID = -1  # no pose in this frame
@@ -198,15 +198,6 @@ def correct_frames(
             if not d > lim:
                 status[f, p] = INSIDE
                 continue
-            # target: the joint of the pair farther (horizontally) from the pelvis
-            dl = (q[jl, 0] - q[pelvis, 0]) ** 2 + (q[jl, 2] - q[pelvis, 2]) ** 2
-            dr = (q[jr, 0] - q[pelvis, 0]) ** 2 + (q[jr, 2] - q[pelvis, 2]) ** 2
-            side = 0 if dl >= dr else 1
-            tj = pair_joints[p, side]
-            sj = start_joints[p, side]
-            target[f, p] = tj
-            for c in range(3):
-                stage_input[f, p, c] = q[tj, c]
             if prev_valid:
                 region(out[f - 1], jl, jr, hip_l, hip_r, tt[p], ee[p], area[p], k_prev)
             else:
@@ -214,6 +205,20 @@ def correct_frames(
                     k_prev[c] = k_now[c]
             for c in range(6):
                 regions[f, p, c] = k_prev[c]
+            # target: the joint of the pair farther (horizontally) from the pelvis; if that one is already inside K'
+            # and the other is not, the other (rotating a joint inside K' would leave the pair apart: a visible spike)
+            dl = (q[jl, 0] - q[pelvis, 0]) ** 2 + (q[jl, 2] - q[pelvis, 2]) ** 2
+            dr = (q[jr, 0] - q[pelvis, 0]) ** 2 + (q[jr, 2] - q[pelvis, 2]) ** 2
+            side = 0 if dl >= dr else 1
+            if inside_value(q[pair_joints[p, side], 0], q[pair_joints[p, side], 2], k_prev) <= 0.0:
+                other = 1 - side
+                if inside_value(q[pair_joints[p, other], 0], q[pair_joints[p, other], 2], k_prev) > 0.0:
+                    side = other
+            tj = pair_joints[p, side]
+            sj = start_joints[p, side]
+            target[f, p] = tj
+            for c in range(3):
+                stage_input[f, p, c] = q[tj, c]
             x, z = q[tj, 0], q[tj, 2]
             if inside_value(x, z, k_prev) <= 0.0:
                 status[f, p] = ALREADY_INSIDE

@@ -64,9 +64,12 @@ def correct_reference(
             jl, jr = PAIR_JOINTS[pi]
             pel = q[INDEX["pelvis"], ::2]
             side = 0 if np.sum((q[jl, ::2] - pel) ** 2) >= np.sum((q[jr, ::2] - pel) ** 2) else 1
-            tj, sj = PAIR_JOINTS[pi, side], START_JOINTS[pi, side]
             prev = out[f - 1] if f > 0 and valid[f - 1] else q
             ell = regions_of(prev[None], constraints, name)[0][0]
+            ins = inside_values(q[PAIR_JOINTS[pi], ::2], np.broadcast_to(ell, (2, 6)))
+            if ins[side] <= 0 < ins[1 - side]:  # the farther joint is inside K', the other is not: take the other
+                side = 1 - side
+            tj, sj = PAIR_JOINTS[pi, side], START_JOINTS[pi, side]
             x = q[tj, ::2]
             if inside_values(x[None], ell[None])[0] <= 0:
                 continue
