@@ -1,0 +1,42 @@
+"""Cloth core: the static model, the relaxation of the paper, Skin-style body collision with capsule bones,
+and adaptive sqrt(3) subdivision.
+
+Typical use::
+
+    model = ClothModel.from_corners(faces, rest_corners)        # (F, 3), (F, 3, 2) metres
+    state = ClothState.new(model, positions, pinned=pins)       # (V, 3) metres
+    collider = BodyCollider.from_body(default_body())
+    relax(model, state, collider, iterations=50)                 # in place
+
+`relax` is not physics: vertices move directly towards their triangles' rest shapes, hinges open, gravity is a
+small move down, and collision pushes the cloth out of the body. Constants live in `ClothParams`.
+"""
+
+from ._collide import BodyCollider, CollisionStats, collide, track, vertex_active
+from ._model import ClothModel, ClothParams, ClothState, Contacts, locality_order
+from ._relax import RelaxStats, relax
+from ._shapes import grid_sheet, grid_tube, hugging_tube, triangle_frames
+from ._subdivide import Refinement, colliding_edges, refine, sqrt3_split
+
+__all__ = [
+    "BodyCollider",
+    "ClothModel",
+    "ClothParams",
+    "ClothState",
+    "CollisionStats",
+    "Contacts",
+    "Refinement",
+    "RelaxStats",
+    "collide",
+    "colliding_edges",
+    "grid_sheet",
+    "grid_tube",
+    "hugging_tube",
+    "locality_order",
+    "refine",
+    "relax",
+    "sqrt3_split",
+    "track",
+    "triangle_frames",
+    "vertex_active",
+]

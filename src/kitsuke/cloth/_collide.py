@@ -1,0 +1,292 @@
+"""Body collision: Skin-style nearest-surface tracking, push-out, and capsule "bones" for vertices and edges."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError
+from ..geometry import TriMesh
+from . import _collide_kernels as K
+from ._model import ClothModel, ClothState
+
+
+def _face_adjacency(faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Face across each local edge k (corners k, k+1) of a closed, consistently wound mesh (F, 3) -1 if none, and
+    how many edges lack a partner or are shared wrongly (boundary or non-manifold)."""
+    nf = len(faces)
+    a = faces.reshape(-1)
+    b = faces[:, [1, 2, 0]].reshape(-1)
+    n = int(faces.max()) + 1
+    key_fwd, key_rev = a * n + b, b * n + a
+    order = np.argsort(key_fwd)
+    sorted_keys = key_fwd[order]
+    pos = np.searchsorted(sorted_keys, key_rev)
+    pos = np.minimum(pos, len(sorted_keys) - 1)
+    found = sorted_keys[pos] == key_rev
+    adj = np.where(found, order[pos] // 3, -1)
+    duplicated = int((np.diff(sorted_keys) == 0).sum())  # a directed edge twice: non-manifold or misoriented
+    return adj.reshape(nf, 3).astype(np.int64), int((~found).sum()) + duplicated
+
+
+@dataclass(eq=False)
+class BodyCollider:
+    """A closed body surface prepared for cloth collision (build with `from_body` or `from_mesh`).
+
+    Attributes
+    ----------
+    vertices : (Vb, 3) float64, metres. faces : (Fb, 3) int64, wound counter-clockwise seen from outside.
+    face_normals : (Fb, 3) unit. edge_normals : (Fb, 3, 3) unit pseudo-normal of each face's edge k (corners k, k+1):
+        the mean of the two faces' normals. vertex_normals : (Vb, 3) unit, angle-weighted: the sign of
+        (p - nearest point) . pseudo-normal tells inside from outside exactly for the true nearest point; the same
+        normals interpolated with barycentrics give the push-out direction.
+    face_adjacency : (Fb, 3) int64, face across each local edge. faces_at_ptr, faces_at : CSR of the faces around
+        each vertex (for the walk).
+    capsule_ends : (C, 2, 3) float64, metres; capsule_radii : (C, 2) float64, metres (tapered capsules).
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    capsule_ends: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 3)))
+    capsule_radii: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    source: str | None = None
+    face_normals: np.ndarray = field(init=False, repr=False)
+    edge_normals: np.ndarray = field(init=False, repr=False)
+    vertex_normals: np.ndarray = field(init=False, repr=False)
+    face_adjacency: np.ndarray = field(init=False, repr=False)
+    faces_at_ptr: np.ndarray = field(init=False, repr=False)
+    faces_at: np.ndarray = field(init=False, repr=False)
+
+    @classmethod
+    def from_mesh(
+        cls,
+        mesh: TriMesh,
+        *,
+        capsule_ends: np.ndarray | None = None,
+        capsule_radii: np.ndarray | None = None,
+        source: str | None = None,
+    ) -> BodyCollider:
+        """Collider for a closed mesh; capsules optional ((C, 2, 3) ends and (C, 2) radii, metres).
+
+        Raises InputError (naming `source`) for a mesh with holes, non-manifold or inconsistently wound edges:
+        inside and outside are undefined there.
+        """
+        ends = np.zeros((0, 2, 3)) if capsule_ends is None else np.asarray(capsule_ends, dtype=np.float64)
+        radii = np.zeros((0, 2)) if capsule_radii is None else np.asarray(capsule_radii, dtype=np.float64)
+        if ends.ndim != 3 or ends.shape[1:] != (2, 3) or radii.shape != (len(ends), 2):
+            raise InputError(f"capsules must be ends (C, 2, 3) and radii (C, 2), got {ends.shape} and {radii.shape}")
+        if not (np.isfinite(ends).all() and np.isfinite(radii).all()) or (radii < 0).any():
+            raise InputError("capsule ends and radii must be finite, radii >= 0")
+        if len(ends) > 63:
+            raise InputError(f"at most 63 capsules are supported, got {len(ends)}")
+        return cls(mesh.vertices, mesh.faces, ends, radii, source)
+
+    @classmethod
+    def from_body(cls, body, posed=None, *, capsules: bool = True) -> BodyCollider:
+        """Collider for a `kitsuke.body.Body`, in its rest pose or in `posed` (a PosedBody), with its capsules."""
+        mesh = body.mesh if posed is None else body.posed_mesh(posed)
+        ends, radii = body.capsule_segments(posed) if capsules else (None, None)
+        return cls.from_mesh(mesh, capsule_ends=ends, capsule_radii=radii, source=body.source or None)
+
+    def __post_init__(self) -> None:
+        v = np.ascontiguousarray(self.vertices, dtype=np.float64)
+        f = np.ascontiguousarray(self.faces, dtype=np.int64)
+        if v.ndim != 2 or v.shape[1] != 3 or f.ndim != 2 or f.shape[1] != 3 or len(f) == 0:
+            raise InputError("body mesh must have vertices (V, 3) and faces (F, 3)", self.source)
+        if not np.isfinite(v).all():
+            raise InputError("body mesh has NaN or infinite coordinates", self.source)
+        self.vertices, self.faces = v, f
+        self.capsule_ends = np.ascontiguousarray(self.capsule_ends, dtype=np.float64).reshape(-1, 2, 3)
+        self.capsule_radii = np.ascontiguousarray(self.capsule_radii, dtype=np.float64).reshape(-1, 2)
+        adj, bad = _face_adjacency(f)
+        if bad:
+            raise InputError(
+                f"body mesh is not closed: {bad} edges are open (holes), non-manifold or wound inconsistently; "
+                "cloth collision needs a closed surface",
+                self.source,
+            )
+        self.face_adjacency = adj
+        tri = v[f]
+        cr = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        length = np.linalg.norm(cr, axis=1, keepdims=True)
+        fn = np.divide(cr, length, out=np.zeros_like(cr), where=length > 0)
+        self.face_normals = fn
+        en = fn[:, None, :] + fn[adj]
+        self.edge_normals = np.ascontiguousarray(en / np.maximum(np.linalg.norm(en, axis=2, keepdims=True), 1e-300))
+        vn = np.zeros_like(v)
+        for k in range(3):
+            e1 = tri[:, (k + 1) % 3] - tri[:, k]
+            e2 = tri[:, (k + 2) % 3] - tri[:, k]
+            cosang = np.einsum("ij,ij->i", e1, e2) / np.maximum(
+                np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1), 1e-300
+            )
+            np.add.at(vn, f[:, k], fn * np.arccos(np.clip(cosang, -1.0, 1.0))[:, None])
+        self.vertex_normals = np.ascontiguousarray(vn / np.maximum(np.linalg.norm(vn, axis=1, keepdims=True), 1e-300))
+        corners = f.reshape(-1)
+        order = np.argsort(corners, kind="stable")
+        self.faces_at = np.ascontiguousarray(order // 3, dtype=np.int64)
+        self.faces_at_ptr = np.zeros(len(v) + 1, dtype=np.int64)
+        np.cumsum(np.bincount(corners, minlength=len(v)), out=self.faces_at_ptr[1:])
+        lo = self.capsule_ends.min(axis=1) - self.capsule_radii.max(axis=1, initial=0.0)[:, None]
+        hi = self.capsule_ends.max(axis=1) + self.capsule_radii.max(axis=1, initial=0.0)[:, None]
+        self._capsule_box = (np.ascontiguousarray(lo), np.ascontiguousarray(hi))
+        self._aabb = None
+
+    def moved(self, vertices: np.ndarray, capsule_ends: np.ndarray | None = None) -> BodyCollider:
+        """The same surface with new vertex positions (V, 3) (a posed body), and optionally moved capsules.
+
+        Face indices stay valid, so cloth contacts keep tracking; call `state.contacts.forget_anchors()` after a
+        large move so that far cloth vertices are searched again.
+        """
+        ends = self.capsule_ends if capsule_ends is None else capsule_ends
+        return BodyCollider(np.asarray(vertices, dtype=np.float64), self.faces, ends, self.capsule_radii, self.source)
+
+    def nearest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Global nearest-surface query (libigl AABB, built once): face (n,) int64, point (n, 3), distance (n,)."""
+        pts = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 3)
+        if self._aabb is None:
+            import igl
+
+            self._aabb = igl.AABB()
+            self._aabb.init(self.vertices, self.faces)
+        if len(pts) == 0:
+            return np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0)
+        d2, face, point = self._aabb.squared_distance(self.vertices, self.faces, pts)
+        return face.astype(np.int64), point, np.sqrt(d2)
+
+
+@dataclass
+class CollisionStats:
+    """What one collision update did.
+
+    searches : vertices that needed a global (AABB) nearest-point search.
+    pushed : vertices pushed out of the body (closer than the offset or inside).
+    deepest_m : the deepest vertex inside the body before the push, metres (0 if none).
+    """
+
+    searches: int = 0
+    pushed: int = 0
+    deepest_m: float = 0.0
+
+
+def _buffers(state: ClothState) -> dict:
+    w = state._work
+    n = len(state.positions)
+    if w.get("n_collide") != n:
+        w["n_collide"] = n
+        w["search"] = np.zeros(n, dtype=np.uint8)
+        w["movable"] = np.zeros(n, dtype=bool)
+        w["near"] = np.zeros(n, dtype=np.int64)
+    return w
+
+
+def active_edges(model: ClothModel, state: ClothState) -> np.ndarray:
+    """(E', 2) int64 edges of the active triangles (cached on the state while face_active is unchanged)."""
+    w = state._work
+    key = state.face_active.tobytes()
+    if w.get("active_edges_key") != key:
+        ef = model.edge_faces
+        on = state.face_active[ef[:, 0]] | ((ef[:, 1] >= 0) & state.face_active[np.maximum(ef[:, 1], 0)])
+        w["active_edges"], w["active_edges_key"] = np.ascontiguousarray(model.edges[on]), key
+    return w["active_edges"]
+
+
+def vertex_active(model: ClothModel, state: ClothState) -> np.ndarray:
+    """(V,) bool: vertices of at least one active triangle (cached on the state while face_active is unchanged)."""
+    key = state.face_active.tobytes()
+    w = state._work
+    if w.get("vertex_active_key") != key or len(w["vertex_active"]) != model.n_vertices:
+        act = np.zeros(model.n_vertices, dtype=bool)
+        act[model.faces[state.face_active].reshape(-1)] = True
+        w["vertex_active"], w["vertex_active_key"] = act, key
+    return w["vertex_active"]
+
+
+def track(model: ClothModel, state: ClothState, collider: BodyCollider, *, active: np.ndarray | None = None) -> int:
+    """Refresh the nearest body point of every active cloth vertex (in place on `state.contacts`).
+
+    Each vertex walks from its tracked body face to neighbouring faces while the nearest point gets closer; new
+    vertices, failed walks and far vertices that may have come near the body get a global AABB search.
+    Returns the number of global searches.
+    """
+    if not isinstance(collider, BodyCollider):
+        raise InputError("collider must be a BodyCollider")
+    state.check(model)
+    p = model.params
+    c = state.contacts
+    act = vertex_active(model, state) if active is None else active
+    w = _buffers(state)
+    K.walk_track(
+        state.positions,
+        act,
+        collider.vertices,
+        collider.faces,
+        collider.face_adjacency,
+        collider.faces_at_ptr,
+        collider.faces_at,
+        collider.face_normals,
+        collider.edge_normals,
+        collider.vertex_normals,
+        collider.vertex_normals,
+        p.walk_max_steps,
+        p.track_distance_m,
+        p.contact_distance_m,
+        c.face,
+        c.bary,
+        c.point,
+        c.normal,
+        c.distance,
+        c.anchor,
+        c.anchor_distance,
+        w["search"],
+    )
+    idx = np.flatnonzero(w["search"])
+    if len(idx):
+        face, _, _ = collider.nearest(state.positions[idx])
+        K.store_found(
+            state.positions,
+            idx,
+            face,
+            collider.vertices,
+            collider.faces,
+            collider.face_normals,
+            collider.edge_normals,
+            collider.vertex_normals,
+            collider.vertex_normals,
+            c.face,
+            c.bary,
+            c.point,
+            c.normal,
+            c.distance,
+            c.anchor,
+            c.anchor_distance,
+        )
+    return len(idx)
+
+
+def collide(model: ClothModel, state: ClothState, collider: BodyCollider) -> CollisionStats:
+    """One collision update (in place): capsules push vertices, then edges, out; the nearest body points are
+    tracked; vertices closer than `params.contact_offset_m` (or inside) move out along the body normal.
+    Pinned vertices and vertices without an active triangle never move.
+    """
+    if not isinstance(collider, BodyCollider):
+        raise InputError("collider must be a BodyCollider")
+    state.check(model)
+    p = model.params
+    act = vertex_active(model, state)
+    w = _buffers(state)
+    movable = np.logical_and(act, ~state.pinned, out=w["movable"])
+    pos = state.positions
+    if len(collider.capsule_ends):
+        lo, hi = collider._capsule_box
+        margin = float(model.rest_lengths.max()) * 1.5  # an edge's far end can be this far from a capsule it cuts
+        K.capsule_vertices(pos, movable, collider.capsule_ends, collider.capsule_radii, lo, hi, margin, w["near"])
+        if p.edge_capsules:
+            K.capsule_edges(
+                pos, active_edges(model, state), movable, collider.capsule_ends, collider.capsule_radii, w["near"]
+            )
+    searches = track(model, state, collider, active=act)
+    c = state.contacts
+    pushed, deepest = K.push_out(pos, movable, p.contact_offset_m, c.face, c.normal, c.distance)
+    return CollisionStats(searches, int(pushed), float(deepest))

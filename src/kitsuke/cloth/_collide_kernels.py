@@ -1,0 +1,444 @@
+"""numba kernels of the body collision (private: call them through `kitsuke.cloth.collide` / `track`).
+
+Nearest-surface tracking after Skin (Markosian et al. 1999) as the paper uses it: every cloth vertex keeps the body
+face of its nearest point and walks from it to neighbouring faces while the nearest point gets closer. Region
+codes of a point on a triangle: 0 inside, 1..3 at corner 0..2, 4..6 on edge 01, 12, 20.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+from numba import njit, prange
+
+PARALLEL = os.environ.get("KITSUKE_NUMBA_PARALLEL", "1") != "0"
+
+#: Relative decrease of the squared distance a walk step must achieve; equal distances (a point on a shared edge
+#: or corner) stop the walk instead of cycling.
+WALK_IMPROVEMENT = 1e-10
+
+
+@njit(cache=True, inline="always")
+def closest_on_triangle(px, py, pz, bv, i0, i1, i2):
+    """Nearest point of triangle (bv[i0], bv[i1], bv[i2]) to p: (cx, cy, cz, b0, b1, b2, region)."""
+    ax, ay, az = bv[i0, 0], bv[i0, 1], bv[i0, 2]
+    abx, aby, abz = bv[i1, 0] - ax, bv[i1, 1] - ay, bv[i1, 2] - az
+    acx, acy, acz = bv[i2, 0] - ax, bv[i2, 1] - ay, bv[i2, 2] - az
+    apx, apy, apz = px - ax, py - ay, pz - az
+    d1 = abx * apx + aby * apy + abz * apz
+    d2 = acx * apx + acy * apy + acz * apz
+    if d1 <= 0.0 and d2 <= 0.0:
+        return ax, ay, az, 1.0, 0.0, 0.0, 1
+    bpx, bpy, bpz = px - bv[i1, 0], py - bv[i1, 1], pz - bv[i1, 2]
+    d3 = abx * bpx + aby * bpy + abz * bpz
+    d4 = acx * bpx + acy * bpy + acz * bpz
+    if d3 >= 0.0 and d4 <= d3:
+        return bv[i1, 0], bv[i1, 1], bv[i1, 2], 0.0, 1.0, 0.0, 2
+    vc = d1 * d4 - d3 * d2
+    if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
+        v = d1 / (d1 - d3)
+        return ax + v * abx, ay + v * aby, az + v * abz, 1.0 - v, v, 0.0, 4
+    cpx, cpy, cpz = px - bv[i2, 0], py - bv[i2, 1], pz - bv[i2, 2]
+    d5 = abx * cpx + aby * cpy + abz * cpz
+    d6 = acx * cpx + acy * cpy + acz * cpz
+    if d6 >= 0.0 and d5 <= d6:
+        return bv[i2, 0], bv[i2, 1], bv[i2, 2], 0.0, 0.0, 1.0, 3
+    vb = d5 * d2 - d1 * d6
+    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
+        w = d2 / (d2 - d6)
+        return ax + w * acx, ay + w * acy, az + w * acz, 1.0 - w, 0.0, w, 6
+    va = d3 * d6 - d5 * d4
+    if va <= 0.0 and d4 - d3 >= 0.0 and d5 - d6 >= 0.0:
+        w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+        bx, by, bz = bv[i1, 0], bv[i1, 1], bv[i1, 2]
+        return bx + w * (bv[i2, 0] - bx), by + w * (bv[i2, 1] - by), bz + w * (bv[i2, 2] - bz), 0.0, 1.0 - w, w, 5
+    s = va + vb + vc
+    if s <= 0.0:  # degenerate triangle: its first corner
+        return ax, ay, az, 1.0, 0.0, 0.0, 1
+    v, w = vb / s, vc / s
+    return ax + v * abx + w * acx, ay + v * aby + w * acy, az + v * abz + w * acz, 1.0 - v - w, v, w, 0
+
+
+@njit(cache=True, inline="always")
+def _pseudo_normal(f, region, bf, face_n, edge_n, vert_n):
+    """Angle-weighted pseudo-normal of the feature `region` of face f: its sign test is exact for the true
+    nearest point of a closed mesh (Baerentzen & Aanaes 2005)."""
+    if region == 0:
+        return face_n[f, 0], face_n[f, 1], face_n[f, 2]
+    if region <= 3:
+        v = bf[f, region - 1]
+        return vert_n[v, 0], vert_n[v, 1], vert_n[v, 2]
+    k = region - 4
+    return edge_n[f, k, 0], edge_n[f, k, 1], edge_n[f, k, 2]
+
+
+@njit(cache=True, inline="always")
+def _store(
+    i,
+    px,
+    py,
+    pz,
+    f,
+    cx,
+    cy,
+    cz,
+    b0,
+    b1,
+    b2,
+    region,
+    bf,
+    face_n,
+    edge_n,
+    vert_n,
+    smooth_n,
+    c_face,
+    c_bary,
+    c_point,
+    c_normal,
+    c_dist,
+):
+    """Write one vertex's contact: face, barycentrics, point, interpolated normal and signed distance."""
+    dx, dy, dz = px - cx, py - cy, pz - cz
+    d = math.sqrt(dx * dx + dy * dy + dz * dz)
+    sx, sy, sz = _pseudo_normal(f, region, bf, face_n, edge_n, vert_n)
+    if dx * sx + dy * sy + dz * sz < 0.0:
+        d = -d
+    j0, j1, j2 = bf[f, 0], bf[f, 1], bf[f, 2]
+    nx = b0 * smooth_n[j0, 0] + b1 * smooth_n[j1, 0] + b2 * smooth_n[j2, 0]
+    ny = b0 * smooth_n[j0, 1] + b1 * smooth_n[j1, 1] + b2 * smooth_n[j2, 1]
+    nz = b0 * smooth_n[j0, 2] + b1 * smooth_n[j1, 2] + b2 * smooth_n[j2, 2]
+    n = math.sqrt(nx * nx + ny * ny + nz * nz)
+    if n > 0.0:
+        nx, ny, nz = nx / n, ny / n, nz / n
+    else:
+        nx, ny, nz = face_n[f, 0], face_n[f, 1], face_n[f, 2]
+    c_face[i] = f
+    c_bary[i, 0], c_bary[i, 1], c_bary[i, 2] = b0, b1, b2
+    c_point[i, 0], c_point[i, 1], c_point[i, 2] = cx, cy, cz
+    c_normal[i, 0], c_normal[i, 1], c_normal[i, 2] = nx, ny, nz
+    c_dist[i] = d
+    return d
+
+
+@njit(cache=True, parallel=PARALLEL)
+def walk_track(
+    pos,
+    active,
+    bv,
+    bf,
+    face_adj,
+    vf_ptr,
+    vf,
+    face_n,
+    edge_n,
+    vert_n,
+    smooth_n,
+    max_steps,
+    track_m,
+    contact_m,
+    c_face,
+    c_bary,
+    c_point,
+    c_normal,
+    c_dist,
+    c_anchor,
+    c_anchor_d,
+    out_search,
+):
+    """Update each active vertex's nearest body point by walking from its tracked face (in place on the c_*
+    contact arrays). out_search (V,) uint8 is set to 1 where a global search is needed: the vertex is untracked,
+    the walk ran out of steps, or it lies farther than `track_m` and may have come within `contact_m` of the body
+    since its last trusted result (anchor). Vertices closer than `track_m` renew their anchor.
+    """
+    nv = pos.shape[0]
+    for i in prange(nv):
+        out_search[i] = 0
+        if not active[i]:
+            continue
+        f = c_face[i]
+        if f < 0:
+            out_search[i] = 1
+            continue
+        px, py, pz = pos[i, 0], pos[i, 1], pos[i, 2]
+        cx, cy, cz, b0, b1, b2, region = closest_on_triangle(px, py, pz, bv, bf[f, 0], bf[f, 1], bf[f, 2])
+        d2 = (px - cx) ** 2 + (py - cy) ** 2 + (pz - cz) ** 2
+        ok = False
+        for _ in range(max_steps):
+            if region == 0:
+                ok = True
+                break
+            best, bd2 = -1, d2 * (1.0 - WALK_IMPROVEMENT)
+            bcx, bcy, bcz, bb0, bb1, bb2, breg = cx, cy, cz, b0, b1, b2, region
+            if region >= 4:
+                g = face_adj[f, region - 4]
+                if g >= 0:
+                    qx, qy, qz, q0, q1, q2, qr = closest_on_triangle(px, py, pz, bv, bf[g, 0], bf[g, 1], bf[g, 2])
+                    e2 = (px - qx) ** 2 + (py - qy) ** 2 + (pz - qz) ** 2
+                    if e2 < bd2:
+                        best, bd2 = g, e2
+                        bcx, bcy, bcz, bb0, bb1, bb2, breg = qx, qy, qz, q0, q1, q2, qr
+            else:
+                v = bf[f, region - 1]
+                for j in range(vf_ptr[v], vf_ptr[v + 1]):
+                    g = vf[j]
+                    if g == f:
+                        continue
+                    qx, qy, qz, q0, q1, q2, qr = closest_on_triangle(px, py, pz, bv, bf[g, 0], bf[g, 1], bf[g, 2])
+                    e2 = (px - qx) ** 2 + (py - qy) ** 2 + (pz - qz) ** 2
+                    if e2 < bd2:
+                        best, bd2 = g, e2
+                        bcx, bcy, bcz, bb0, bb1, bb2, breg = qx, qy, qz, q0, q1, q2, qr
+            if best < 0:
+                ok = True
+                break
+            f, d2 = best, bd2
+            cx, cy, cz, b0, b1, b2, region = bcx, bcy, bcz, bb0, bb1, bb2, breg
+        if not ok:
+            out_search[i] = 1
+            continue
+        d = math.sqrt(d2)
+        if d > track_m:
+            ax, ay, az = px - c_anchor[i, 0], py - c_anchor[i, 1], pz - c_anchor[i, 2]
+            moved = math.sqrt(ax * ax + ay * ay + az * az)
+            if moved >= c_anchor_d[i] - contact_m:
+                out_search[i] = 1
+                continue
+        sd = _store(
+            i,
+            px,
+            py,
+            pz,
+            f,
+            cx,
+            cy,
+            cz,
+            b0,
+            b1,
+            b2,
+            region,
+            bf,
+            face_n,
+            edge_n,
+            vert_n,
+            smooth_n,
+            c_face,
+            c_bary,
+            c_point,
+            c_normal,
+            c_dist,
+        )
+        if d <= track_m:
+            c_anchor[i, 0], c_anchor[i, 1], c_anchor[i, 2] = px, py, pz
+            c_anchor_d[i] = sd
+
+
+@njit(cache=True)
+def store_found(
+    pos,
+    idx,
+    found_face,
+    bv,
+    bf,
+    face_n,
+    edge_n,
+    vert_n,
+    smooth_n,
+    c_face,
+    c_bary,
+    c_point,
+    c_normal,
+    c_dist,
+    c_anchor,
+    c_anchor_d,
+):
+    """Write the contacts of vertices idx (n,) whose nearest body face a global search found (found_face (n,)),
+    and make their positions the new anchors."""
+    for j in range(idx.shape[0]):
+        i, f = idx[j], found_face[j]
+        px, py, pz = pos[i, 0], pos[i, 1], pos[i, 2]
+        cx, cy, cz, b0, b1, b2, region = closest_on_triangle(px, py, pz, bv, bf[f, 0], bf[f, 1], bf[f, 2])
+        sd = _store(
+            i,
+            px,
+            py,
+            pz,
+            f,
+            cx,
+            cy,
+            cz,
+            b0,
+            b1,
+            b2,
+            region,
+            bf,
+            face_n,
+            edge_n,
+            vert_n,
+            smooth_n,
+            c_face,
+            c_bary,
+            c_point,
+            c_normal,
+            c_dist,
+        )
+        c_anchor[i, 0], c_anchor[i, 1], c_anchor[i, 2] = px, py, pz
+        c_anchor_d[i] = sd
+
+
+@njit(cache=True, parallel=PARALLEL)
+def push_out(pos, movable, offset, c_face, c_normal, c_dist):
+    """Move each movable tracked vertex closer to the body than `offset` (or inside) along the interpolated body
+    normal until it is `offset` outside (in place; updates c_dist). Returns (vertices moved, deepest depth inside
+    before the move, metres)."""
+    nv = pos.shape[0]
+    pushed = 0
+    deepest = 0.0
+    for i in prange(nv):
+        if movable[i] and c_face[i] >= 0 and c_dist[i] < offset:
+            d = c_dist[i]
+            deepest = max(deepest, -d)
+            pushed += 1
+            s = offset - d
+            pos[i, 0] += s * c_normal[i, 0]
+            pos[i, 1] += s * c_normal[i, 1]
+            pos[i, 2] += s * c_normal[i, 2]
+            c_dist[i] = offset
+    return pushed, deepest
+
+
+@njit(cache=True, inline="always")
+def _segment_point(px, py, pz, ax, ay, az, bx, by, bz):
+    """Parameter t in [0, 1] of the point of segment a-b nearest p."""
+    ux, uy, uz = bx - ax, by - ay, bz - az
+    uu = ux * ux + uy * uy + uz * uz
+    if uu <= 0.0:
+        return 0.0
+    t = ((px - ax) * ux + (py - ay) * uy + (pz - az) * uz) / uu
+    return min(1.0, max(0.0, t))
+
+
+@njit(cache=True, parallel=PARALLEL)
+def capsule_vertices(pos, movable, ends, radii, lo, hi, margin, out_near):
+    """Push movable vertices out of tapered capsules (in place): a vertex nearer a capsule's axis than the radius
+    there (linear between the end radii, at the axis point nearest the vertex) moves radially to that radius.
+
+    lo, hi (C, 3): each capsule's bounding box. out_near (V,) int64: bit c set where the vertex is within
+    `margin` metres of capsule c's box (so edges need only test the capsules near their ends; C <= 63).
+    """
+    nv, nc = pos.shape[0], ends.shape[0]
+    for i in prange(nv):
+        bits = 0
+        for c in range(nc):
+            px, py, pz = pos[i, 0], pos[i, 1], pos[i, 2]
+            if (
+                px < lo[c, 0] - margin
+                or px > hi[c, 0] + margin
+                or py < lo[c, 1] - margin
+                or py > hi[c, 1] + margin
+                or pz < lo[c, 2] - margin
+                or pz > hi[c, 2] + margin
+            ):
+                continue
+            bits |= 1 << c
+            if not movable[i]:
+                continue
+            ax, ay, az = ends[c, 0, 0], ends[c, 0, 1], ends[c, 0, 2]
+            bx, by, bz = ends[c, 1, 0], ends[c, 1, 1], ends[c, 1, 2]
+            t = _segment_point(px, py, pz, ax, ay, az, bx, by, bz)
+            r = radii[c, 0] + t * (radii[c, 1] - radii[c, 0])
+            qx, qy, qz = ax + t * (bx - ax), ay + t * (by - ay), az + t * (bz - az)
+            dx, dy, dz = px - qx, py - qy, pz - qz
+            d = math.sqrt(dx * dx + dy * dy + dz * dz)
+            if d >= r:
+                continue
+            if d <= 1e-12:  # on the axis: out along any perpendicular
+                ux, uy, uz = bx - ax, by - ay, bz - az
+                dx, dy, dz = (
+                    (uy, -ux, 0.0) if abs(uz) < 0.9 * math.sqrt(ux * ux + uy * uy + uz * uz) else (0.0, uz, -uy)
+                )
+                d = math.sqrt(dx * dx + dy * dy + dz * dz)
+                if d == 0.0:
+                    dx, dy, dz, d = 1.0, 0.0, 0.0, 1.0
+            f = r / d
+            pos[i, 0], pos[i, 1], pos[i, 2] = qx + dx * f, qy + dy * f, qz + dz * f
+        out_near[i] = bits
+
+
+@njit(cache=True, inline="always")
+def segment_segment(p1x, p1y, p1z, q1x, q1y, q1z, p2x, p2y, p2z, q2x, q2y, q2z):
+    """Parameters (s, t) in [0, 1] of the nearest points of segments p1-q1 and p2-q2 (clamped closest points)."""
+    d1x, d1y, d1z = q1x - p1x, q1y - p1y, q1z - p1z
+    d2x, d2y, d2z = q2x - p2x, q2y - p2y, q2z - p2z
+    rx, ry, rz = p1x - p2x, p1y - p2y, p1z - p2z
+    a = d1x * d1x + d1y * d1y + d1z * d1z
+    e = d2x * d2x + d2y * d2y + d2z * d2z
+    f = d2x * rx + d2y * ry + d2z * rz
+    if a <= 1e-300 and e <= 1e-300:
+        return 0.0, 0.0
+    if a <= 1e-300:
+        return 0.0, min(1.0, max(0.0, f / e))
+    c = d1x * rx + d1y * ry + d1z * rz
+    if e <= 1e-300:
+        return min(1.0, max(0.0, -c / a)), 0.0
+    b = d1x * d2x + d1y * d2y + d1z * d2z
+    den = a * e - b * b
+    s = min(1.0, max(0.0, (b * f - c * e) / den)) if den > 1e-300 else 0.0
+    t = (b * s + f) / e
+    if t < 0.0:
+        t = 0.0
+        s = min(1.0, max(0.0, -c / a))
+    elif t > 1.0:
+        t = 1.0
+        s = min(1.0, max(0.0, (b - c) / a))
+    return s, t
+
+
+@njit(cache=True)
+def capsule_edges(pos, edges, movable, ends, radii, near):
+    """Push cloth edges out of tapered capsules (in place, Gauss-Seidel over edges): where an edge's nearest point
+    to a capsule axis lies inside the capsule, its two vertices move along the separating direction so that this
+    point reaches the capsule surface (weighted by where along the edge it lies; a held vertex takes no share).
+    near (V,) int64: the capsule bits of `capsule_vertices`; an edge tests the capsules near either end.
+    """
+    for e in range(edges.shape[0]):
+        i, j = edges[e, 0], edges[e, 1]
+        bits = near[i] | near[j]
+        if bits == 0 or not (movable[i] or movable[j]):
+            continue
+        c = 0
+        while bits != 0:
+            if bits & 1:
+                ax, ay, az = ends[c, 0, 0], ends[c, 0, 1], ends[c, 0, 2]
+                bx, by, bz = ends[c, 1, 0], ends[c, 1, 1], ends[c, 1, 2]
+                s, t = segment_segment(
+                    pos[i, 0], pos[i, 1], pos[i, 2], pos[j, 0], pos[j, 1], pos[j, 2], ax, ay, az, bx, by, bz
+                )
+                r = radii[c, 0] + t * (radii[c, 1] - radii[c, 0])
+                ex = pos[i, 0] + s * (pos[j, 0] - pos[i, 0]) - (ax + t * (bx - ax))
+                ey = pos[i, 1] + s * (pos[j, 1] - pos[i, 1]) - (ay + t * (by - ay))
+                ez = pos[i, 2] + s * (pos[j, 2] - pos[i, 2]) - (az + t * (bz - az))
+                d = math.sqrt(ex * ex + ey * ey + ez * ez)
+                # Outside, or exactly on the axis (no direction; the vertex pass handles ends).
+                if r > d > 1e-12:
+                    wi = (1.0 - s) if movable[i] else 0.0
+                    wj = s if movable[j] else 0.0
+                    ww = wi * wi + wj * wj
+                    # Skip when only a held vertex's near end is inside: moving the other end would fling it.
+                    if ww > 1e-2:
+                        k = (r - d) / (d * ww)  # moves the edge point by (r - d) along e / d
+                        pos[i, 0] += wi * k * ex
+                        pos[i, 1] += wi * k * ey
+                        pos[i, 2] += wi * k * ez
+                        pos[j, 0] += wj * k * ex
+                        pos[j, 1] += wj * k * ey
+                        pos[j, 2] += wj * k * ez
+            bits >>= 1
+            c += 1
+
+
+def set_parallel(parallel: bool) -> None:
+    """Recompile the per-vertex kernels with or without threads (for benchmarks; not cached)."""
+    g = globals()
+    for name in ("walk_track", "push_out", "capsule_vertices"):
+        g[name] = njit(parallel=parallel)(g[name].py_func)

@@ -1,0 +1,34 @@
+"""Quality measures of a dressed garment (SPEC §6): penetration, strain, seam gap, inverted triangles, and a
+JSON-ready report with pass/fail per measure against the targets of issue 3.
+
+    report = quality_report(positions, faces, body.mesh, rest_lengths=model.rest_lengths)
+    report.ok, report.failures(), report.to_dict()
+"""
+
+from ._measures import (
+    COLLAPSE_RATIO,
+    Penetration,
+    SeamGap,
+    Strain,
+    inverted_triangles,
+    mesh_edges,
+    penetration,
+    seam_gap,
+    strain,
+)
+from ._report import QualityReport, QualityTargets, quality_report
+
+__all__ = [
+    "COLLAPSE_RATIO",
+    "Penetration",
+    "QualityReport",
+    "QualityTargets",
+    "SeamGap",
+    "Strain",
+    "inverted_triangles",
+    "mesh_edges",
+    "penetration",
+    "quality_report",
+    "seam_gap",
+    "strain",
+]

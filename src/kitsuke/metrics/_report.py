@@ -1,0 +1,130 @@
+"""The quality report of a dressed garment: all measures of SPEC §6 against the targets of issue 3."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from ..errors import InputError
+from ..geometry import TriMesh
+from ._measures import _faces, _points, inverted_triangles, mesh_edges, penetration, seam_gap, strain
+
+
+@dataclass(frozen=True)
+class QualityTargets:
+    """Pass/fail limits (issue 3, item 6).
+
+    penetration_mm : no cloth vertex deeper inside the body than this. max_strain, mean_strain : edge strain
+    limits (fractions: 0.05 = 5 %). seam_gap_mm : largest gap between seam sides. inverted : most inverted
+    triangles allowed.
+    """
+
+    penetration_mm: float = 2.0
+    max_strain: float = 0.05
+    mean_strain: float = 0.01
+    seam_gap_mm: float = 3.0
+    inverted: int = 0
+
+
+@dataclass
+class QualityReport:
+    """Measures of one dressed garment and whether each meets its target. `to_dict()` is JSON-ready.
+
+    penetration_count : vertices deeper than targets.penetration_mm inside the body. penetration_deepest_mm : the
+    deepest vertex inside (mm, 0 if none). strain_mean, strain_max : edge strain (fractions). strain_worst_edges :
+    indices into the edges, worst first. seam_gap_mm : largest gap over all seams, seam_gaps_mm per seam.
+    inverted_count, inverted_faces (the first 20). passed : {measure: bool}; ok : all passed.
+    """
+
+    n_vertices: int
+    n_faces: int
+    penetration_count: int
+    penetration_deepest_mm: float
+    strain_mean: float
+    strain_max: float
+    strain_stretched: float
+    strain_compressed: float
+    strain_worst_edges: list[int]
+    seam_gap_mm: float
+    seam_gaps_mm: list[float]
+    inverted_count: int
+    inverted_faces: list[int]
+    targets: QualityTargets = field(default_factory=QualityTargets)
+    passed: dict[str, bool] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return all(self.passed.values())
+
+    def failures(self) -> list[str]:
+        """One line per measure that missed its target, saying by how much."""
+        t = self.targets
+        lines = {
+            "penetration": f"{self.penetration_count} vertices deeper than {t.penetration_mm} mm inside the body "
+            f"(deepest {self.penetration_deepest_mm:.1f} mm)",
+            "max_strain": f"max edge strain {100 * self.strain_max:.1f} % > {100 * t.max_strain:.1f} %",
+            "mean_strain": f"mean edge strain {100 * self.strain_mean:.2f} % > {100 * t.mean_strain:.2f} %",
+            "seam_gap": f"seam gap {self.seam_gap_mm:.1f} mm > {t.seam_gap_mm} mm",
+            "inverted": f"{self.inverted_count} inverted triangles > {t.inverted}",
+        }
+        return [lines[k] for k, v in self.passed.items() if not v]
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["ok"] = self.ok
+        return d
+
+
+def quality_report(
+    positions: np.ndarray,
+    faces: np.ndarray,
+    body: TriMesh,
+    *,
+    rest_lengths: np.ndarray,
+    edges: np.ndarray | None = None,
+    seams: Sequence[tuple[np.ndarray, np.ndarray]] = (),
+    rest_areas: np.ndarray | None = None,
+    targets: QualityTargets | None = None,
+) -> QualityReport:
+    """All quality measures of cloth at `positions` (V, 3) metres with `faces` (F, 3) on `body`.
+
+    rest_lengths : (E,) metres, per edge of `edges` (default `mesh_edges(faces)`, the order ClothModel uses).
+    seams : pairs of vertex index arrays (see `seam_gap`); none for a sewn mesh that shares seam vertices.
+    rest_areas : (F,) square metres, to count collapsed triangles as inverted (see `inverted_triangles`).
+    """
+    t = targets or QualityTargets()
+    pos = _points(positions, "positions")
+    f = _faces(faces, len(pos))
+    e = mesh_edges(f) if edges is None else np.asarray(edges)
+    if len(np.asarray(rest_lengths)) != len(e):
+        raise InputError(f"rest_lengths has {len(np.asarray(rest_lengths))} entries for {len(e)} edges")
+    pen = penetration(pos, body, threshold_m=t.penetration_mm / 1e3)
+    st = strain(pos, e, rest_lengths)
+    gap = seam_gap(pos, seams)
+    inv = np.flatnonzero(inverted_triangles(pos, f, rest_areas=rest_areas))
+    report = QualityReport(
+        n_vertices=len(pos),
+        n_faces=len(f),
+        penetration_count=pen.count,
+        penetration_deepest_mm=round(pen.deepest_mm, 3),
+        strain_mean=round(st.mean, 6),
+        strain_max=round(st.max, 6),
+        strain_stretched=round(st.stretched, 6),
+        strain_compressed=round(st.compressed, 6),
+        strain_worst_edges=[int(i) for i in st.worst_edges],
+        seam_gap_mm=round(gap.max_mm, 3),
+        seam_gaps_mm=[round(g, 3) for g in gap.per_seam_mm],
+        inverted_count=len(inv),
+        inverted_faces=[int(i) for i in inv[:20]],
+        targets=t,
+    )
+    report.passed = {
+        "penetration": pen.count == 0,
+        "max_strain": st.max <= t.max_strain,
+        "mean_strain": st.mean <= t.mean_strain,
+        "seam_gap": gap.max_mm <= t.seam_gap_mm,
+        "inverted": len(inv) <= t.inverted,
+    }
+    return report

@@ -1,0 +1,201 @@
+"""Body collision: nearest-point tracking against brute force, push-out, capsules, and cloth on the default body."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from kitsuke.cloth import BodyCollider, ClothModel, ClothParams, ClothState, collide, relax, track
+from kitsuke.cloth import _collide_kernels as CK
+from kitsuke.cloth._shapes import grid_sheet
+from kitsuke.errors import InputError
+from kitsuke.geometry import TriMesh
+from kitsuke.metrics import penetration
+
+from . import reference as ref
+from .conftest import icosphere
+
+
+def test_closest_on_triangle_matches_reference(rng):
+    for _ in range(300):
+        tri = rng.normal(size=(3, 3))
+        p = rng.normal(size=3) * 2
+        cx, cy, cz, b0, b1, b2, region = CK.closest_on_triangle(p[0], p[1], p[2], tri, 0, 1, 2)
+        want = ref.closest_on_triangle(p, *tri)
+        np.testing.assert_allclose([cx, cy, cz], want, atol=1e-9)
+        np.testing.assert_allclose(b0 * tri[0] + b1 * tri[1] + b2 * tri[2], want, atol=1e-9)
+        assert b0 + b1 + b2 == pytest.approx(1.0) and min(b0, b1, b2) >= -1e-12
+        assert (region == 0) == (min(b0, b1, b2) > 1e-12)
+
+
+def bumpy_sphere() -> TriMesh:
+    """A non-convex closed surface: a sphere with dents and bumps (radius 10 cm +- 2 cm)."""
+    s = icosphere(0.1, 4)
+    v = s.vertices
+    d = v / np.linalg.norm(v, axis=1, keepdims=True)
+    r = 0.1 + 0.02 * np.sin(3 * d[:, 0]) * np.cos(4 * d[:, 1]) * np.sin(2 * d[:, 2] + 1)
+    return TriMesh(d * r[:, None], s.faces)
+
+
+def point_cloud_model(points: np.ndarray, params: ClothParams | None = None) -> tuple[ClothModel, ClothState]:
+    """Cloth vertices to track, grouped by three into separate triangles (which only make them active)."""
+    n = len(points)
+    faces = np.arange(n).reshape(-1, 3)
+    corners = np.tile([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], (n // 3, 1, 1))
+    model = ClothModel.from_corners(faces, corners, params=params)
+    return model, ClothState.new(model, points)
+
+
+@pytest.mark.parametrize("shape", ["sphere", "bumpy"])
+def test_tracking_matches_brute_force(shape, rng):
+    """Global search, then walks after small moves, against the nearest point over all faces. On a convex surface
+    the walk's local minimum is the global one; on a bumpy one it may settle in a neighbouring shallow dent (a
+    Skin-style tracker's nature, as it is for points inside): then it must still be within 0.5 mm of the true
+    distance, and rare."""
+    mesh = icosphere(0.1, 3) if shape == "sphere" else bumpy_sphere()
+    col = BodyCollider.from_mesh(mesh)
+    d = ref.unit(rng.normal(size=(60, 3)))
+    pts = d * rng.uniform(0.105 if shape == "sphere" else 0.06, 0.15, (60, 1))
+    model, state = point_cloud_model(pts)
+    assert track(model, state, col) == 60  # all new: global searches
+    near = exact = 0
+    for step in range(4):
+        if step:
+            state.positions += rng.normal(0, 0.004, state.positions.shape)  # small moves: walks
+            track(model, state, col)
+        c = state.contacts
+        for i in range(len(pts)):
+            f, point, dist = ref.closest_on_mesh(state.positions[i], mesh.vertices, mesh.faces)
+            if dist > model.params.track_distance_m:
+                continue  # far away only a lower bound matters (see the next test)
+            near += 1
+            np.testing.assert_allclose(mesh.vertices[mesh.faces[c.face[i]]].T @ c.bary[i], c.point[i], atol=1e-9)
+            assert abs(c.distance[i]) == pytest.approx(np.linalg.norm(state.positions[i] - c.point[i]), abs=1e-12)
+            assert abs(c.distance[i]) - dist < 5e-4
+            if np.allclose(c.point[i], point, atol=1e-9):
+                exact += 1
+            elif step == 0 or shape == "sphere":
+                raise AssertionError(f"vertex {i}: tracked {c.point[i]}, nearest {point}")
+    assert near > 100 and exact >= 0.9 * near
+    # Signs: inside the (closed) surface negative, by the generalised winding number.
+    import igl
+
+    inside = igl.winding_number(mesh.vertices, mesh.faces, state.positions) > 0.5
+    np.testing.assert_array_equal(state.contacts.distance < 0, inside)
+
+
+def test_far_vertex_is_searched_again_when_it_may_come_near():
+    """Two separate spheres: a vertex tracked far from sphere A moves next to sphere B. Its walk cannot leave A,
+    but it has moved farther than its distance from the body at its last trusted result, so it may be in contact:
+    a global search finds B."""
+    a, b = icosphere(0.1, 2), icosphere(0.1, 2, centre=(1.0, 0.0, 0.0))
+    two = TriMesh(np.r_[a.vertices, b.vertices], np.r_[a.faces, b.faces + len(a.vertices)])
+    col = BodyCollider.from_mesh(two)
+    model, state = point_cloud_model(np.array([[0.0, 0.5, 0.0], [0.0, 0.6, 0.0], [0.0, 0.7, 0.0]]))
+    track(model, state, col)
+    assert state.contacts.distance[0] == pytest.approx(0.4, abs=2e-3)
+    state.positions[0] = [0.01, 0.49, 0.0]  # a small move, still far: the walk result stands
+    assert track(model, state, col) == 0
+    state.positions[0] = [1.0, 0.103, 0.0]  # next to sphere B
+    assert track(model, state, col) == 1
+    assert state.contacts.face[0] >= len(a.faces)
+    assert state.contacts.distance[0] == pytest.approx(0.003, abs=1.5e-3)
+    assert state.contacts.normal[0, 1] > 0.99
+
+
+def test_moved_body_keeps_tracking(sphere):
+    col = BodyCollider.from_mesh(sphere)
+    model, state = point_cloud_model(np.array([[0.0, 0.104, 0.0], [0.104, 0.0, 0.0], [0.0, 0.3, 0.0]]))
+    track(model, state, col)
+    moved = col.moved(sphere.vertices + [0.0, 0.01, 0.0])  # the body rose 1 cm: the first vertex is now inside
+    state.contacts.forget_anchors()
+    assert track(model, state, moved) == 1  # only the far vertex is searched again; the near ones walk
+    assert state.contacts.distance[0] == pytest.approx(-0.006, abs=1e-3)
+    collide(model, state, moved)
+    track(model, state, moved)
+    assert state.contacts.distance[0] == pytest.approx(model.params.contact_offset_m, abs=2e-4)
+
+
+def test_collider_rejects_open_mesh(sphere):
+    with pytest.raises(InputError, match="not closed"):
+        BodyCollider.from_mesh(TriMesh(sphere.vertices, sphere.faces[1:]), source="holey.obj")
+    flipped = sphere.faces.copy()
+    flipped[0] = flipped[0, ::-1]
+    with pytest.raises(InputError, match="holey.obj"):
+        BodyCollider.from_mesh(TriMesh(sphere.vertices, flipped), source="holey.obj")
+    with pytest.raises(InputError, match="capsules"):
+        BodyCollider.from_mesh(sphere, capsule_ends=np.zeros((2, 3)), capsule_radii=np.zeros((2, 2)))
+
+
+def test_push_out_moves_inside_vertices_out_and_keeps_pins(sphere, sphere_collider, rng):
+    pts = ref.unit(rng.normal(size=(42, 3))) * rng.uniform(0.05, 0.099, (42, 1))
+    model, state = point_cloud_model(pts)
+    state.pinned[:6] = True
+    stats = collide(model, state, sphere_collider)
+    assert stats.pushed == 36 and stats.deepest_m > 0.0
+    np.testing.assert_array_equal(state.positions[:6], pts[:6])
+    assert penetration(state.positions[6:], sphere, threshold_m=0.0).count == 0
+    track(model, state, sphere_collider)
+    np.testing.assert_allclose(state.contacts.distance[6:], model.params.contact_offset_m, atol=2e-4)
+
+
+def test_capsule_vertices_pushed_to_tapered_surface(rng):
+    ends = np.array([[[0.0, 0.0, 0.0], [0.0, 0.3, 0.0]]])
+    radii = np.array([[0.05, 0.02]])
+    pts = np.c_[rng.uniform(-0.04, 0.04, 200), rng.uniform(0.0, 0.3, 200), rng.uniform(-0.04, 0.04, 200)]
+    before = pts.copy()
+    movable = np.ones(200, dtype=bool)
+    near = np.zeros(200, dtype=np.int64)
+    lo, hi = ends.min(axis=1) - 0.05, ends.max(axis=1) + 0.05
+    CK.capsule_vertices(pts, movable, ends, radii, lo, hi, 0.0, near)
+    assert (near == 1).all()
+    t = np.clip(pts[:, 1] / 0.3, 0, 1)
+    r_here = 0.05 + t * (0.02 - 0.05)
+    dist = np.linalg.norm(pts[:, [0, 2]], axis=1)
+    was_in = np.linalg.norm(before[:, [0, 2]], axis=1) < 0.05 + np.clip(before[:, 1] / 0.3, 0, 1) * -0.03
+    np.testing.assert_allclose(dist[was_in], r_here[was_in], atol=1e-9)  # radially out, at the same height
+    np.testing.assert_array_equal(pts[~was_in], before[~was_in])
+    np.testing.assert_allclose(pts[:, 1], before[:, 1], atol=1e-12)
+
+
+def test_segment_segment_matches_sampling(rng):
+    for _ in range(100):
+        p1, q1, p2, q2 = rng.normal(size=(4, 3))
+        s, t = CK.segment_segment(*p1, *q1, *p2, *q2)
+        d = np.linalg.norm(p1 + s * (q1 - p1) - (p2 + t * (q2 - p2)))
+        assert d == pytest.approx(ref.segment_segment_distance(p1, q1, p2, q2), abs=1e-6)
+
+
+def test_edge_through_capsule_is_pushed_out():
+    ends = np.array([[[0.0, 0.0, -0.2], [0.0, 0.0, 0.2]]])  # along z
+    radii = np.array([[0.03, 0.03]])
+    lo, hi = ends.min(axis=1) - 0.03, ends.max(axis=1) + 0.03
+    pos = np.array([[-0.05, 0.01, 0.0], [0.05, 0.01, 0.0], [0.0, 0.2, 0.0]])  # edge 0-1 cuts the capsule
+    edges = np.array([[0, 1], [1, 2], [0, 2]])
+    movable = np.ones(3, dtype=bool)
+    before = pos.copy()
+    near = np.zeros(3, dtype=np.int64)
+    CK.capsule_vertices(pos, movable, ends, radii, lo, hi, 0.1, near)
+    np.testing.assert_array_equal(pos, before)  # no vertex inside: vertex collision alone misses it
+    np.testing.assert_array_equal(near, [1, 1, 0])  # the far vertex is beyond the margin
+    CK.capsule_edges(pos, edges, movable, ends, radii, near)
+    s, t = CK.segment_segment(*pos[0], *pos[1], *ends[0, 0], *ends[0, 1])
+    gap = np.linalg.norm(pos[0] + s * (pos[1] - pos[0]) - (ends[0, 0] + t * (ends[0, 1] - ends[0, 0])))
+    assert gap == pytest.approx(0.03, abs=1e-9)
+    assert pos[0, 1] == pytest.approx(0.03) and pos[1, 1] == pytest.approx(0.03)  # lifted straight up
+
+
+def test_sheet_partly_inside_the_default_body_ends_outside(body, body_collider):
+    """A 30 x 30 cm sheet across the belly, its middle 3 cm inside the body: after relaxation with collision no
+    vertex is more than 2 mm inside (the SPEC §6 measure)."""
+    uv, faces = grid_sheet(21, 21, 0.015)
+    model = ClothModel.from_flat(faces, uv)
+    pos = np.c_[uv - 0.15, np.zeros(len(uv))] + [0.0, 1.0, 0.0]
+    v = body.mesh.vertices
+    front = v[(np.abs(v[:, 1] - 1.0) < 0.01) & (np.abs(v[:, 0]) < 0.15), 2].max()
+    pos[:, 2] = front - 0.03 + 0.6 * np.sum((uv - 0.15) ** 2, axis=1)  # curved, deepest in the middle
+    assert penetration(pos, body.mesh).count > 50
+    state = ClothState.new(model, pos)
+    relax(model, state, body_collider, iterations=60)
+    pen = penetration(state.positions, body.mesh)
+    assert pen.count == 0 and pen.deepest_mm <= 2.0

@@ -1,0 +1,162 @@
+"""Each relaxation kernel against its plain-numpy reference on small random cases."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from kitsuke.cloth import ClothParams
+from kitsuke.cloth import _kernels as K
+
+from . import reference as ref
+from .conftest import flat_sheet
+
+#: Kernels and references do the same arithmetic in a different order or method: agreement to 1e-9 m.
+ATOL = 1e-9
+
+
+@pytest.fixture
+def crumpled(rng):
+    """A 6 x 5 sheet with its vertices jittered out of the plane by about a third of an edge."""
+    model, pos = flat_sheet(6, 5, 0.02)
+    pos = pos + rng.normal(0, 0.006, pos.shape)
+    return model, np.ascontiguousarray(pos)
+
+
+def test_reference_normals_match(crumpled, rng):
+    model, pos = crumpled
+    pos[model.faces[3]] = pos[model.faces[3]][[0, 2, 1]]  # fold one triangle over its neighbours
+    active = rng.random(model.n_faces) > 0.2
+    nf = model.n_faces
+    out_n, out_ref, out_f = np.zeros((nf, 3)), np.zeros((nf, 3)), np.zeros(nf, dtype=np.uint8)
+    for unflip in (True, False):
+        K.reference_normals(
+            pos, model.faces, model.face_adjacency, model.face_adjacency_sign, active, unflip, out_n, out_ref, out_f
+        )
+        n, r, f = ref.reference_normals(
+            pos, model.faces, model.face_adjacency, model.face_adjacency_sign, active, unflip
+        )
+        np.testing.assert_allclose(out_n, n, atol=ATOL)
+        np.testing.assert_allclose(out_ref, r, atol=ATOL)
+        np.testing.assert_array_equal(out_f.astype(bool), f)
+    assert out_f.any()
+
+
+def test_shape_match_goals_match(crumpled, rng):
+    model, pos = crumpled
+    active = rng.random(model.n_faces) > 0.2
+    # Reference normals: mostly own normals, some random unit vectors (the un-flip case projects off-plane).
+    tri = pos[model.faces]
+    n = ref.unit(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]))
+    some = rng.random(model.n_faces) < 0.3
+    n[some] = ref.unit(rng.normal(size=(some.sum(), 3)))
+    out = np.zeros((model.n_faces, 3, 3))
+    K.shape_match_goals(pos, model.faces, model.rest_corners, n, active, out)
+    want = ref.shape_match_goals(pos, model.faces, model.rest_corners, n, active)
+    np.testing.assert_allclose(out[active], want[active], atol=ATOL)
+    # Goals are congruent to the rest triangles.
+    g = out[active]
+    rest = model.rest_corners[active]
+    for k in range(3):
+        glen = np.linalg.norm(g[:, (k + 1) % 3] - g[:, k], axis=1)
+        rlen = np.linalg.norm(rest[:, (k + 1) % 3] - rest[:, k], axis=1)
+        np.testing.assert_allclose(glen, rlen, atol=ATOL)
+
+
+def test_hinge_deltas_match(crumpled, rng):
+    model, pos = crumpled
+    active = rng.random(model.n_faces) > 0.1
+    out = np.zeros((len(model.hinges), 4, 3))
+    K.hinge_deltas(pos, model.hinges, model.hinge_faces, active, out)
+    want = ref.hinge_deltas(pos, model.hinges, model.hinge_faces, active)
+    np.testing.assert_allclose(out, want, atol=ATOL)
+    # The moves sum to zero (the hinge's centre stays), and the wings' own moves flatten it: 180 degrees.
+    np.testing.assert_allclose(out.sum(axis=1), 0.0, atol=ATOL)
+    h = int(np.argmax(np.abs(out).sum(axis=(1, 2))))
+    a, b, c, d = model.hinges[h]
+    p = pos.copy()
+    p[[c, d]] += out[h, 2:]
+    e = p[b] - p[a]
+    cp = p[c] - p[a] - ((p[c] - p[a]) @ e) / (e @ e) * e
+    dp = p[d] - p[a] - ((p[d] - p[a]) @ e) / (e @ e) * e
+    assert ref.unit(cp) @ ref.unit(dp) == pytest.approx(-1.0, abs=1e-9)
+
+
+def test_gather_moves_match(crumpled, rng):
+    model, pos = crumpled
+    p = ClothParams(stretch_stiffness=0.9, bend_stiffness=0.3, gravity_step_m=0.001, friction=0.5, max_step_m=0.004)
+    nf, nv = model.n_faces, model.n_vertices
+    active = rng.random(nf) > 0.2
+    goals = pos[model.faces] + rng.normal(0, 0.003, (nf, 3, 3))
+    hinge = rng.normal(0, 0.002, (len(model.hinges), 4, 3))
+    pinned = rng.random(nv) < 0.1
+    face = np.where(rng.random(nv) < 0.5, 0, -1)
+    dist = rng.uniform(0, 0.01, nv)
+    normal = ref.unit(rng.normal(size=(nv, 3)))
+    out, step = np.zeros((nv, 3)), np.zeros(nv)
+    K.gather_moves(
+        pos,
+        goals,
+        hinge,
+        model.vertex_corners_ptr,
+        model.vertex_corners,
+        model.vertex_hinges_ptr,
+        model.vertex_hinges,
+        active,
+        model.hinge_faces,
+        pinned,
+        face,
+        dist,
+        normal,
+        p.stretch_stiffness,
+        p.bend_stiffness,
+        p.gravity_step_m,
+        p.friction,
+        p.contact_distance_m,
+        p.max_step_m,
+        out,
+        step,
+    )
+    touching = (face >= 0) & (dist < p.contact_distance_m)
+    want = ref.gather_moves(
+        pos, goals, hinge, model.faces, model.hinges, model.hinge_faces, active, pinned, touching, normal, p
+    )
+    np.testing.assert_allclose(out, want, atol=ATOL)
+    np.testing.assert_allclose(step, np.linalg.norm(want - pos, axis=1), atol=ATOL)
+    assert step.max() == pytest.approx(p.max_step_m)  # the clamp was exercised
+
+
+def test_support_order_and_limit_strain_match(crumpled, rng):
+    model, pos = crumpled
+    pos = pos * np.array([1.0, 1.3, 1.0])  # stretched 30 % along y: most vertical edges exceed the limit
+    nv = model.n_vertices
+    roots = rng.random(nv) < 0.1
+    active = rng.random(nv) > 0.1
+    by_height = rng.permutation(nv).astype(np.int64)
+    order, rank = np.zeros(nv, dtype=np.int64), np.zeros(nv, dtype=np.int64)
+    n = K.support_order(pos, roots, active, by_height, order, rank)
+    assert (np.diff(pos[by_height, 1]) <= 0).all()
+    want = ref.support_order(pos, roots, active)
+    assert n == len(want)
+    np.testing.assert_array_equal(np.sort(order[:n]), np.sort(want))  # ties in height may come in any order
+    assert roots[order[: roots[active].sum()]].all() and not roots[order[roots[active].sum() : n]].any()
+    np.testing.assert_array_equal(rank[order[:n]], np.arange(n))
+    assert (rank[~active] == -1).all()
+    movable = active & ~roots
+    got = pos.copy()
+    K.limit_strain(
+        order,
+        n,
+        rank,
+        movable,
+        model.adjacency_ptr,
+        model.adjacency,
+        model.adjacency_edge,
+        model.rest_lengths,
+        0.01,
+        got,
+    )
+    expect = ref.limit_strain(pos, order[:n], model.edges, model.rest_lengths, movable, 0.01)
+    np.testing.assert_allclose(got, expect, atol=ATOL)
+    assert not np.allclose(got, pos)
+    np.testing.assert_array_equal(got[~movable], pos[~movable])

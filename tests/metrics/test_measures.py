@@ -1,0 +1,149 @@
+"""Quality measures against hand-computed answers."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from kitsuke.cloth import grid_sheet, grid_tube
+from kitsuke.errors import InputError
+from kitsuke.geometry import TriMesh
+from kitsuke.metrics import (
+    QualityTargets,
+    inverted_triangles,
+    mesh_edges,
+    penetration,
+    quality_report,
+    seam_gap,
+    strain,
+)
+
+
+@pytest.fixture(scope="module")
+def box() -> TriMesh:
+    """A closed 20 x 20 x 20 cm box centred at the origin: distances to it are exact by hand."""
+    import trimesh
+
+    b = trimesh.creation.box(extents=(0.2, 0.2, 0.2))
+    return TriMesh(np.asarray(b.vertices), np.asarray(b.faces))
+
+
+def test_penetration_counts_and_depths(box):
+    pts = np.array(
+        [
+            [0.0, 0.0, 0.3],  # outside
+            [0.0, 0.0, 0.099],  # 1 mm inside: below the 2 mm threshold
+            [0.0, 0.0, 0.095],  # 5 mm inside
+            [0.05, 0.02, 0.0],  # 5 cm inside (nearest face x = 0.1)
+            [0.0, 0.0, 0.1005],  # just outside
+        ]
+    )
+    p = penetration(pts, box)
+    assert p.count == 2
+    assert p.deepest_mm == pytest.approx(50.0)
+    np.testing.assert_allclose(p.depth_m, [0.0, 0.001, 0.005, 0.05, 0.0], atol=1e-12)
+    assert penetration(pts, box, threshold_m=0.0).count == 3
+    assert penetration(np.zeros((0, 3)), box).count == 0
+
+
+def test_strain_by_hand():
+    pos = np.array([[0.0, 0.0, 0.0], [1.1, 0.0, 0.0], [0.0, 0.9, 0.0]])
+    edges = np.array([[0, 1], [0, 2], [1, 2]])
+    rest = np.array([1.0, 1.0, np.hypot(1.1, 0.9)])
+    s = strain(pos, edges, rest)
+    np.testing.assert_allclose(s.per_edge, [0.1, 0.1, 0.0], atol=1e-12)
+    assert s.mean == pytest.approx(0.2 / 3) and s.max == pytest.approx(0.1)
+    assert s.stretched == pytest.approx(0.1) and s.compressed == pytest.approx(0.1)
+    assert set(s.worst_edges[:2]) == {0, 1}
+    with pytest.raises(InputError, match="rest_lengths"):
+        strain(pos, edges, rest[:2])
+    with pytest.raises(InputError, match="positive"):
+        strain(pos, edges, np.array([1.0, 0.0, 1.0]))
+
+
+def test_seam_gap_by_hand():
+    pos = np.array([[0.0, 0, 0], [0.0, 0.001, 0], [0.0, 0.002, 0.0], [0.0, 0.0, 0.003], [0.0, 0.001, 0.0]])
+    g = seam_gap(pos, [(np.array([0, 1]), np.array([3, 4])), (np.array([2]), np.array([2]))])
+    assert g.per_seam_mm == pytest.approx([3.0, 0.0])
+    assert g.max_mm == pytest.approx(3.0)
+    assert seam_gap(pos, []).max_mm == 0.0
+    with pytest.raises(InputError, match="seam 0"):
+        seam_gap(pos, [(np.array([0, 1]), np.array([3]))])
+    with pytest.raises(InputError, match="do not exist"):
+        seam_gap(pos, [(np.array([0]), np.array([9]))])
+
+
+def test_inverted_triangles_definition():
+    uv, f = grid_sheet(6, 6, 0.01)
+    flat = np.c_[uv, np.zeros(len(uv))]
+    assert not inverted_triangles(flat, f).any()
+    # A curved surface (a tube) is not inverted anywhere, seams included.
+    faces, _, _ = grid_tube(10, 4, 0.01)
+    i, j = np.arange(40) % 10, np.arange(40) // 10
+    tube = np.c_[np.sin(2 * np.pi * i / 10), 0.3 * j, np.cos(2 * np.pi * i / 10)] * 0.05
+    assert not inverted_triangles(tube, faces).any()
+    # Fold a corner triangle back over its neighbour: that triangle, and only it, is inverted.
+    counts = np.bincount(f.reshape(-1))
+    v = int(np.flatnonzero(counts == 1)[0])
+    t = int(np.flatnonzero((f == v).any(axis=1))[0])
+    a, b = [k for k in f[t] if k != v]
+    folded = flat.copy()
+    e = (folded[b] - folded[a]) / np.linalg.norm(folded[b] - folded[a])
+    foot = folded[a] + ((folded[v] - folded[a]) @ e) * e
+    folded[v] = foot + 0.9 * (foot - folded[v]) + [0, 0, 0.001]
+    inv = inverted_triangles(folded, f)
+    assert np.flatnonzero(inv).tolist() == [t]
+    # A mesh whose winding differs between two triangles is not inverted: neighbours are compared as wound.
+    g = f.copy()
+    g[t] = g[t, ::-1]
+    assert not inverted_triangles(flat, g).any()
+    # Collapsed (area below 1 % of rest): inverted when the rest areas are given.
+    squashed = flat.copy()
+    squashed[v] = foot
+    rest_areas = np.full(len(f), 0.5e-4)
+    assert inverted_triangles(squashed, f, rest_areas=rest_areas)[t]
+    assert not inverted_triangles(squashed, f)[t]
+
+
+def test_quality_report_pass_and_fail(box):
+    uv, f = grid_sheet(5, 5, 0.01)
+    edges = mesh_edges(f)
+    rest = np.linalg.norm(uv[edges[:, 0]] - uv[edges[:, 1]], axis=1)
+    outside = np.c_[uv - 0.02, np.full(len(uv), 0.105)]  # 5 mm in front of the box's +z face
+    good = quality_report(outside, f, box, rest_lengths=rest)
+    assert good.ok and good.failures() == []
+    assert good.penetration_count == 0 and good.strain_max == pytest.approx(0.0, abs=1e-12)
+    d = json.loads(json.dumps(good.to_dict()))
+    assert d["ok"] is True and d["targets"]["max_strain"] == 0.05 and d["n_faces"] == len(f)
+
+    bad = outside * [1.08, 1.0, 1.0]  # 8 % stretch along x
+    bad[0, 2] = 0.09  # one vertex 1 cm inside
+    r = quality_report(bad, f, box, rest_lengths=rest, seams=[(np.array([0]), np.array([24]))])
+    assert not r.ok
+    assert r.passed == {
+        "penetration": False,
+        "max_strain": False,
+        "mean_strain": False,
+        "seam_gap": False,
+        "inverted": True,
+    }
+    assert r.penetration_count == 1 and r.penetration_deepest_mm == pytest.approx(10.0, abs=0.01)
+    assert len(r.failures()) == 4 and "penetration" not in r.failures()[0]
+    assert "inside the body" in r.failures()[0]
+    lenient = quality_report(bad, f, box, rest_lengths=rest, targets=QualityTargets(max_strain=1.0, mean_strain=0.5))
+    assert lenient.passed["max_strain"] and lenient.passed["mean_strain"]
+
+
+def test_quality_report_rejects_bad_input(box):
+    uv, f = grid_sheet(3, 3, 0.01)
+    pos = np.c_[uv, np.zeros(len(uv))]
+    with pytest.raises(InputError, match="rest_lengths"):
+        quality_report(pos, f, box, rest_lengths=np.ones(3))
+    with pytest.raises(InputError, match="faces"):
+        quality_report(pos, f + 100, box, rest_lengths=np.ones(16))
+    with pytest.raises(InputError, match="positions"):
+        quality_report(pos[:, :2], f, box, rest_lengths=np.ones(16))
+    with pytest.raises(InputError, match="body"):
+        penetration(pos, "body.obj")  # type: ignore[arg-type]
