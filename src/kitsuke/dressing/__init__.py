@@ -1,0 +1,86 @@
+"""Sketch-based dressing (SPEC §4): corresponding strokes on the pattern and the body; the wrap comes next.
+
+- `read_strokes(path)` / `write_strokes(strokes, path)`: kitsuke strokes v1 JSON (SPEC §3.2).
+- `check_strokes(strokes, pattern, pattern_mesh=...)`: the pattern side (pieces, points on them, triangles
+  crossed).
+- `resolve_strokes(strokes, pattern, surface)`: body strokes projected (drawn points) or cast (laser rays)
+  onto the body or garment surface, each point with its face and barycentric coordinates.
+- Helpers for the wrap: `triangles_crossed`, `arc_length`, `arc_parameters`, `resample_polyline`,
+  `resample_on_surface`, `stroke_coordinates`.
+- `packaged_strokes_path()` / `load_packaged_strokes()`: shipped strokes (the kimono on the default body).
+"""
+
+from importlib import resources
+from pathlib import Path
+
+from ._polyline import (
+    arc_length,
+    arc_parameters,
+    densify_polyline,
+    interpolate_polyline,
+    resample_on_surface,
+    resample_polyline,
+    stroke_coordinates,
+    surface_length,
+    surface_polyline,
+)
+from .strokes import (
+    FORMAT,
+    MAX_SURFACE_DISTANCE_M,
+    PIECE_TOLERANCE_CM,
+    VERSION,
+    BodyStroke,
+    PatternStroke,
+    StrokePair,
+    Strokes,
+    check_strokes,
+    read_strokes,
+    resolve_strokes,
+    strokes_from_dict,
+    strokes_to_dict,
+    strokes_to_json,
+    triangles_crossed,
+    write_strokes,
+)
+
+
+def packaged_strokes_path(name: str = "kimono_default") -> Path:
+    """Path of a strokes file shipped in kitsuke/assets/strokes (`name` without .json)."""
+    ref = resources.files("kitsuke.assets") / "strokes" / f"{name}.json"
+    return Path(str(ref))
+
+
+def load_packaged_strokes(name: str = "kimono_default") -> Strokes:
+    """Read a packaged strokes file: "kimono_default" is the kimono (`make_kimono()`) on `default_body()`."""
+    return read_strokes(packaged_strokes_path(name))
+
+
+__all__ = [
+    "FORMAT",
+    "MAX_SURFACE_DISTANCE_M",
+    "PIECE_TOLERANCE_CM",
+    "VERSION",
+    "BodyStroke",
+    "PatternStroke",
+    "StrokePair",
+    "Strokes",
+    "arc_length",
+    "arc_parameters",
+    "check_strokes",
+    "densify_polyline",
+    "interpolate_polyline",
+    "load_packaged_strokes",
+    "packaged_strokes_path",
+    "read_strokes",
+    "resample_on_surface",
+    "resample_polyline",
+    "resolve_strokes",
+    "stroke_coordinates",
+    "strokes_from_dict",
+    "strokes_to_dict",
+    "strokes_to_json",
+    "surface_length",
+    "surface_polyline",
+    "triangles_crossed",
+    "write_strokes",
+]
