@@ -83,9 +83,7 @@ def test_surface_resampling_follows_the_body(body_surface, kimono):
     pts = np.array([[0.12, 1.30, 0.10], [0.12, 1.40, 0.01], [0.12, 1.30, -0.06]])
     st = (
         resolve_strokes(
-            Strokes(
-                [StrokePair(1, PatternStroke("migoro_left", [[5, 120], [5, 140]]), BodyStroke(points=pts))]
-            ),
+            Strokes([StrokePair(1, PatternStroke("migoro_left", [[5, 120], [5, 140]]), BodyStroke(points=pts))]),
             kimono,
             body_surface,
         )

@@ -48,9 +48,7 @@ def test_point_outside_piece(kimono):
 def test_stroke_leaving_a_concave_piece(kimono):
     # Both ends on migoro_left, but the straight segment between them crosses the neck opening.
     s = one([[3.0, 140.0], [3.0, 163.0]], chest_points())
-    with pytest.raises(
-        InputError, match=r"stroke 5: pattern stroke leaves piece 'migoro_left' between points 0 and 1"
-    ):
+    with pytest.raises(InputError, match=r"stroke 5: pattern stroke leaves piece 'migoro_left' between points 0 and 1"):
         check_strokes(s, kimono)
 
 
@@ -70,9 +68,7 @@ def test_crossing_no_triangle_of_the_mesh(kimono, kimono_mesh):
     check_strokes(s, kimono, pattern_mesh=kimono_mesh)
     # A mesh of another pattern whose piece has the same name but lies elsewhere.
     other = Pattern("other", [Piece("migoro_left", [[100, 0], [130, 0], [130, 30], [100, 30]])])
-    with pytest.raises(
-        InputError, match=r"stroke 5: pattern stroke crosses no triangle of piece 'migoro_left'"
-    ):
+    with pytest.raises(InputError, match=r"stroke 5: pattern stroke crosses no triangle of piece 'migoro_left'"):
         check_strokes(s, kimono, pattern_mesh=mesh_pattern(other, edge_length=5.0))
     lonely = Pattern("other", [Piece("okumi", [[0, 0], [30, 0], [30, 30]])])
     with pytest.raises(InputError, match=r"stroke 5: piece 'migoro_left' is not in the meshed pattern"):
@@ -104,9 +100,7 @@ def test_points_1cm_off_the_body_land_on_it_on_their_side(body, body_surface, ki
     assert np.median(moved) < 1e-3 and moved.max() < 0.01
     # Never farther than the vertex itself (1 cm), and 1 cm for most (less in hollows, where another face is
     # nearer).
-    assert r.surface.distance.max() <= 0.01 + 1e-12 and np.median(r.surface.distance) == pytest.approx(
-        0.01, abs=1e-4
-    )
+    assert r.surface.distance.max() <= 0.01 + 1e-12 and np.median(r.surface.distance) == pytest.approx(0.01, abs=1e-4)
     # On the right side: the surface faces the drawn point.
     normals = body_surface.normals_at(r.faces)
     assert (np.einsum("ij,ij->i", drawn - r.surface_points, normals) > 0).all()
@@ -147,9 +141,7 @@ def test_laser_first_and_last_through_the_chest(body_surface, kimono):
     front, back = r.pair(1).body, r.pair(2).body
     assert (front.surface_points[:, 2] > back.surface_points[:, 2] + 0.1).all()  # the chest is > 10 cm deep
     for b in (front, back):
-        np.testing.assert_allclose(
-            b.surface_points[:, [0, 1]], [[0, y] for y in (1.25, 1.20, 1.15)], atol=1e-9
-        )
+        np.testing.assert_allclose(b.surface_points[:, [0, 1]], [[0, y] for y in (1.25, 1.20, 1.15)], atol=1e-9)
         assert body_surface.closest(b.surface_points).distance.max() < 1e-6  # on the surface
         assert np.allclose(b.surface.distance, 2.0 - b.surface_points[:, 2])  # distance along the ray
     # The front faces the ray's origin, the back faces away from it.
@@ -207,7 +199,5 @@ def test_packaged_kimono_strokes_resolve_on_the_default_body(body, body_surface,
     for side in ("l", "r"):
         sleeve = by_piece[f"sode_{'left' if side == 'l' else 'right'}"][0]
         start, end = sleeve[0], sleeve[-1]
-        assert np.linalg.norm(end - j[INDEX[f"{side}_wrist"]]) < np.linalg.norm(
-            start - j[INDEX[f"{side}_wrist"]]
-        )
+        assert np.linalg.norm(end - j[INDEX[f"{side}_wrist"]]) < np.linalg.norm(start - j[INDEX[f"{side}_wrist"]])
         assert abs(start[0]) > abs(j[INDEX[f"{side}_shoulder"]][0])

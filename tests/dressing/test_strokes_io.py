@@ -34,9 +34,7 @@ def sample_dict() -> dict:
             {
                 "id": 7,
                 "pattern": {"piece": "migoro_left", "points": [[5.0, 170.0], [5.0, 190.0]]},
-                "body": {
-                    "laser": {"rays": [[0.07, 1.3, 1.0, 0, 0, -1], [0.07, 1.2, 1.0, 0, 0, -2]], "hit": "last"}
-                },
+                "body": {"laser": {"rays": [[0.07, 1.3, 1.0, 0, 0, -1], [0.07, 1.2, 1.0, 0, 0, -2]], "hit": "last"}},
             },
         ],
     }
@@ -55,9 +53,7 @@ def test_read_gives_typed_strokes(tmp_path):
     assert p1.pattern.piece == "migoro_left" and p1.pattern.points.shape == (3, 2)
     assert p1.pattern.points.dtype == np.float64
     assert p1.body.points.shape == (2, 3) and not p1.body.is_laser and not p1.body.resolved
-    assert (
-        p7.body.is_laser and p7.body.hit == "last" and p7.body.rays.shape == (2, 6) and p7.body.n_points == 2
-    )
+    assert p7.body.is_laser and p7.body.hit == "last" and p7.body.rays.shape == (2, 6) and p7.body.n_points == 2
     assert p1.pattern.length_cm == pytest.approx(20.0 + math.hypot(1.0, 10.0))
     with pytest.raises(KeyError):
         s.pair(3)

@@ -76,9 +76,7 @@ def surface_length(surface: Surface, points: np.ndarray, *, step_m: float = 0.00
     return float(arc_length(surface_polyline(surface, points, step_m=step_m).points)[-1])
 
 
-def resample_on_surface(
-    surface: Surface, points: np.ndarray, k: int, *, step_m: float = 0.005
-) -> SurfacePoints:
+def resample_on_surface(surface: Surface, points: np.ndarray, k: int, *, step_m: float = 0.005) -> SurfacePoints:
     """`k` surface points equally spaced by arc length along the path that a polyline (n, 3) metres traces on
     the surface (densified to `step_m`, projected, measured, resampled, projected again); ends are the
     projections of the polyline's ends."""
@@ -102,9 +100,7 @@ def stroke_coordinates(points: np.ndarray, stroke: np.ndarray) -> tuple[np.ndarr
     a, e = p[:-1], np.diff(p, axis=0)
     ee = np.einsum("ij,ij->i", e, e)
     rel = q[:, None, :] - a[None, :, :]  # (n, m-1, 2)
-    t = np.clip(
-        np.divide(np.einsum("nmk,mk->nm", rel, e), ee, out=np.zeros(rel.shape[:2]), where=ee > 0), 0, 1
-    )
+    t = np.clip(np.divide(np.einsum("nmk,mk->nm", rel, e), ee, out=np.zeros(rel.shape[:2]), where=ee > 0), 0, 1)
     diff = rel - t[..., None] * e[None]
     d2 = np.einsum("nmk,nmk->nm", diff, diff)
     seg = np.argmin(d2, axis=1)
@@ -136,8 +132,6 @@ def polygon_distance(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
     e = np.roll(a, -1, axis=0) - a
     ee = np.einsum("ij,ij->i", e, e)
     rel = q[:, None, :] - a[None]
-    t = np.clip(
-        np.divide(np.einsum("nmk,mk->nm", rel, e), ee, out=np.zeros(rel.shape[:2]), where=ee > 0), 0, 1
-    )
+    t = np.clip(np.divide(np.einsum("nmk,mk->nm", rel, e), ee, out=np.zeros(rel.shape[:2]), where=ee > 0), 0, 1)
     diff = rel - t[..., None] * e[None]
     return np.sqrt(np.einsum("nmk,nmk->nm", diff, diff).min(axis=1))

@@ -230,9 +230,7 @@ class Strokes:
         seen: dict[int, int] = {}
         for k, p in enumerate(self.pairs):
             if p.id in seen:
-                raise InputError(
-                    f"stroke id {p.id} is used twice (pairs {seen[p.id]} and {k})", self.source or None
-                )
+                raise InputError(f"stroke id {p.id} is used twice (pairs {seen[p.id]} and {k})", self.source or None)
             seen[p.id] = k
 
     def __len__(self) -> int:
@@ -318,9 +316,7 @@ def strokes_from_dict(d: Any) -> Strokes:
     if fmt != FORMAT:
         raise InputError(f"not a kitsuke strokes file (format is {fmt!r}, expected {FORMAT!r})")
     if d.get("version") != VERSION:
-        raise InputError(
-            f"unsupported {FORMAT} version {d.get('version')!r} (this kitsuke reads version {VERSION})"
-        )
+        raise InputError(f"unsupported {FORMAT} version {d.get('version')!r} (this kitsuke reads version {VERSION})")
     target = d.get("target", "body")
     if target not in ("body", "garment"):
         raise InputError(f"target must be 'body' or 'garment', got {target!r}")
@@ -343,11 +339,7 @@ def strokes_to_dict(strokes: Strokes) -> dict[str, Any]:
     pairs = []
     for p in strokes.pairs:
         b = p.body
-        body = (
-            {"points": _rows(b.points)}
-            if b.points is not None
-            else {"laser": {"rays": _rows(b.rays), "hit": b.hit}}
-        )
+        body = {"points": _rows(b.points)} if b.points is not None else {"laser": {"rays": _rows(b.rays), "hit": b.hit}}
         pairs.append(
             {
                 "id": p.id,
@@ -378,10 +370,7 @@ _NUMBER_LIST = re.compile(r"\[\s*(-?[0-9][0-9.eE+-]*(?:,\s*-?[0-9][0-9.eE+-]*)*)
 def strokes_to_json(strokes: Strokes) -> str:
     """The text of a strokes file: indented JSON with each point on one line (easy to read and edit)."""
     text = json.dumps(strokes_to_dict(strokes), indent=1, allow_nan=False, ensure_ascii=False)
-    return (
-        _NUMBER_LIST.sub(lambda m: "[" + ", ".join(x.strip() for x in m.group(1).split(",")) + "]", text)
-        + "\n"
-    )
+    return _NUMBER_LIST.sub(lambda m: "[" + ", ".join(x.strip() for x in m.group(1).split(",")) + "]", text) + "\n"
 
 
 def write_strokes(strokes: Strokes, path: str | os.PathLike[str]) -> None:
@@ -415,9 +404,7 @@ def check_strokes(strokes: Strokes, pattern: Pattern, *, pattern_mesh: PatternMe
         ps, ctx = pair.pattern, f"stroke {pair.id}"
         if ps.piece not in pattern.piece_names:
             names = ", ".join(pattern.piece_names)
-            raise InputError(
-                f"{ctx}: pattern piece {ps.piece!r} is not in pattern {pattern.name!r} ({names})", path
-            )
+            raise InputError(f"{ctx}: pattern piece {ps.piece!r} is not in pattern {pattern.name!r} ({names})", path)
         if ps.piece not in polygons:
             polygons[ps.piece] = pattern.piece(ps.piece).polygon()
         poly = polygons[ps.piece]
@@ -434,9 +421,7 @@ def check_strokes(strokes: Strokes, pattern: Pattern, *, pattern_mesh: PatternMe
         out = ~polygon_inside(dense, poly) & (polygon_distance(dense, poly) > PIECE_TOLERANCE_CM)
         if out.any():
             # Which drawn segment the first outside sample belongs to.
-            seg = int(
-                np.searchsorted(arc_length(ps.points), arc_length(dense)[int(np.argmax(out))], side="right")
-            )
+            seg = int(np.searchsorted(arc_length(ps.points), arc_length(dense)[int(np.argmax(out))], side="right"))
             seg = min(max(seg - 1, 0), len(ps.points) - 2)
             raise InputError(
                 f"{ctx}: pattern stroke leaves piece {ps.piece!r} between points {seg} and {seg + 1}", path
@@ -507,8 +492,7 @@ def resolve_strokes(
         sp = resolved[p.id]
         if arc_length(sp.points)[-1] < MIN_SURFACE_LENGTH_M:
             raise InputError(
-                f"stroke {p.id}: body stroke has zero length on the {what} surface "
-                "(its points land on one spot)",
+                f"stroke {p.id}: body stroke has zero length on the {what} surface (its points land on one spot)",
                 path,
             )
         pairs.append(StrokePair(p.id, p.pattern, dataclasses.replace(p.body, surface=sp)))

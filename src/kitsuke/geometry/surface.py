@@ -61,9 +61,7 @@ class SurfacePoints:
 
     def take(self, index: np.ndarray) -> SurfacePoints:
         """The subset (or reordering) `index` (an int or bool array)."""
-        return SurfacePoints(
-            self.points[index], self.faces[index], self.barycentric[index], self.distance[index]
-        )
+        return SurfacePoints(self.points[index], self.faces[index], self.barycentric[index], self.distance[index])
 
     @staticmethod
     def empty() -> SurfacePoints:
@@ -213,9 +211,7 @@ class Surface:
         return out
 
     # -- evaluation ------------------------------------------------------------------------------------------
-    def evaluate(
-        self, faces: np.ndarray, barycentric: np.ndarray, vertices: np.ndarray | None = None
-    ) -> np.ndarray:
+    def evaluate(self, faces: np.ndarray, barycentric: np.ndarray, vertices: np.ndarray | None = None) -> np.ndarray:
         """Points (n, 3) at barycentric coordinates (n, 3) in faces (n,) — of `vertices` (V, 3) if given (the
         same mesh moved, e.g. posed), else of this surface."""
         v = self.vertices if vertices is None else np.asarray(vertices, dtype=np.float64)
