@@ -1,4 +1,7 @@
-"""Sketch-based dressing (SPEC §4): corresponding strokes on the pattern and the body; the wrap comes next.
+"""Sketch-based dressing (SPEC §4): corresponding strokes on the pattern and the body, and the wrap.
+
+- `wrap(body, pattern_or_mesh, strokes)` -> `DressedGarment`: strokes' triangles placed on the body, the rest grown
+  from the placed cloth, seams shut, a gravity settle; with a quality report (work in progress: see its docstring).
 
 - `read_strokes(path)` / `write_strokes(strokes, path)`: kitsuke strokes v1 JSON (SPEC §3.2).
 - `check_strokes(strokes, pattern, pattern_mesh=...)`: the pattern side (pieces, points on them, triangles
@@ -42,6 +45,7 @@ from .strokes import (
     triangles_crossed,
     write_strokes,
 )
+from .wrap import DressedGarment, WrapParams, wrap
 
 
 def packaged_strokes_path(name: str = "kimono_default") -> Path:
@@ -56,6 +60,9 @@ def load_packaged_strokes(name: str = "kimono_default") -> Strokes:
 
 
 __all__ = [
+    "DressedGarment",
+    "WrapParams",
+    "wrap",
     "FORMAT",
     "MAX_SURFACE_DISTANCE_M",
     "PIECE_TOLERANCE_CM",

@@ -1,0 +1,65 @@
+"""Benchmark: wrap + settle of GarmentCode's shirt (1.5 cm edges) on mean_all with the packaged strokes.
+
+    /work/venv/bin/python benchmarks/bench_wrap.py [--repeat 5]
+
+Prints the per-step timings of each run after a warm-up run (numba compilation, AABB trees) and the quality.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--repeat", type=int, default=5)
+    args = ap.parse_args()
+    from kitsuke.body import load_body
+    from kitsuke.cloth import BodyCollider
+    from kitsuke.dressing import read_strokes, resolve_strokes
+    from kitsuke.dressing.wrap import wrap
+    from kitsuke.geometry.surface import Surface
+    from kitsuke.pattern import load_pattern, mesh_pattern
+
+    body = load_body(ROOT / "tests/data/bodies/mean_all.obj")
+    pattern = load_pattern(ROOT / "tests/data/pattern/shirt_mean_specification.json")
+    strokes = read_strokes(ROOT / "src/kitsuke/assets/strokes/shirt_mean_all.json")
+    pm = mesh_pattern(pattern, edge_length=1.5)
+    resolved = resolve_strokes(strokes, pattern, Surface(body.mesh), pattern_mesh=pm)
+    collider = BodyCollider.from_body(body)
+    wrap(body, pm, resolved, collider=collider, report=False)  # warm-up
+    walls = []
+    for _ in range(args.repeat):
+        t = time.perf_counter()
+        g = wrap(body, pm, resolved, collider=collider, report=False)
+        walls.append(time.perf_counter() - t)
+        print("  ".join(f"{k} {v * 1e3:.0f} ms" for k, v in g.timings.items()))
+    print(
+        f"shirt {pm.n_vertices} pattern vertices, {g.n_vertices} garment vertices, {len(g.faces)} faces, "
+        f"{g.rings} rings"
+    )
+    print(
+        f"wrap + settle (meshed pattern, resolved strokes, collider given): median {np.median(walls):.3f} s, "
+        f"min {min(walls):.3f} s over {args.repeat} runs"
+    )
+    t = time.perf_counter()
+    g = wrap(body, pattern, strokes)
+    print(
+        f"from files' objects (meshing, stroke resolution, collider, report included): {time.perf_counter() - t:.3f} s"
+    )
+    r = g.report
+    print(
+        f"quality: penetration {r.penetration_count} (deepest {r.penetration_deepest_mm:.1f} mm), strain mean "
+        f"{100 * r.strain_mean:.1f} % max {100 * r.strain_max:.0f} %, seam gap {r.seam_gap_mm} mm, inverted "
+        f"{r.inverted_count}, stroke residual max {1e3 * g.max_stroke_residual_m:.0f} mm"
+    )
+
+
+if __name__ == "__main__":
+    main()

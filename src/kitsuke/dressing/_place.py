@@ -1,0 +1,172 @@
+"""Wrap step 1: the pattern triangles each pattern stroke crosses are laid onto the body along its body stroke.
+
+Arc-length correspondence: a pattern point at arc-length fraction t along its pattern stroke goes to the body
+stroke's point at the same fraction t (so the whole pattern stroke lies on the whole body stroke). Its signed
+distance across the stroke is laid out along the body surface perpendicular to the stroke (the direction
+normal x tangent, which is "left" of the stroke seen from outside, matching the pattern's left seen from the
+piece's outer face), then projected back onto the surface and lifted `lift_m` off it along the normal.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..cloth import BodyCollider
+from ..errors import InputError
+from ..geometry.surface import Surface
+from ..pattern import PatternMesh
+from ._polyline import (
+    arc_length,
+    interpolate_polyline,
+    resample_on_surface,
+    resample_polyline,
+    stroke_coordinates,
+)
+from ._weld import Welded
+from .strokes import Strokes, triangles_crossed
+
+#: Body stroke paths are followed on the surface at this spacing, metres.
+PATH_STEP_M = 0.003
+#: Pattern strokes are sampled at this many points for the residual (distance to the body stroke after wrap).
+RESIDUAL_SAMPLES = 32
+
+
+@dataclass
+class StrokeTrack:
+    """Where a pattern stroke lies on the garment and which body path it must follow.
+
+    id : stroke id. faces : (n,) int64 garment faces holding the stroke's samples; bary : (n, 3) their
+    barycentric coordinates. body_path : (k, 3) float64 metres, the body stroke traced on the surface.
+    pattern_length_m, body_length_m : the two strokes' lengths, metres.
+    """
+
+    id: int
+    faces: np.ndarray
+    bary: np.ndarray
+    body_path: np.ndarray
+    pattern_length_m: float
+    body_length_m: float
+
+    def points(self, positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
+        """(n, 3) the stroke's samples on the garment at `positions` (V, 3)."""
+        return np.einsum("ij,ijk->ik", self.bary, positions[faces[self.faces]])
+
+    def residual_m(self, positions: np.ndarray, faces: np.ndarray) -> float:
+        """Largest distance, metres, from a sample of the pattern stroke on the garment to the body stroke."""
+        return float(polyline_distance(self.points(positions, faces), self.body_path).max())
+
+
+@dataclass
+class Placement:
+    """The transferred stroke triangles.
+
+    positions : (V, 3) float64 metres (meaningful where `placed`). placed : (V,) bool. seed_faces : (F,) bool,
+    garment faces crossed by a stroke. tracks : one StrokeTrack per stroke pair, in drawing order.
+    """
+
+    positions: np.ndarray
+    placed: np.ndarray
+    seed_faces: np.ndarray
+    tracks: list[StrokeTrack]
+
+
+def polyline_distance(points: np.ndarray, line: np.ndarray) -> np.ndarray:
+    """(n,) distance of points (n, 3) to a polyline (k, 3), any units."""
+    a, e = line[:-1], np.diff(line, axis=0)
+    ee = np.maximum(np.einsum("ij,ij->i", e, e), 1e-300)
+    rel = points[:, None, :] - a[None]
+    t = np.clip(np.einsum("nmk,mk->nm", rel, e) / ee, 0.0, 1.0)
+    d = rel - t[..., None] * e[None]
+    return np.sqrt(np.einsum("nmk,nmk->nm", d, d).min(axis=1))
+
+
+def smooth_normals(collider: BodyCollider, faces: np.ndarray, bary: np.ndarray) -> np.ndarray:
+    """(n, 3) unit body normals interpolated from the vertex normals at surface points (faces, barycentrics)."""
+    n = np.einsum("ij,ijk->ik", bary, collider.vertex_normals[collider.faces[faces]])
+    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+
+
+def _locate(pm: PatternMesh, faces: np.ndarray, points_cm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The face among `faces` holding each 2D point (the best one if on none) and its barycentric coordinates."""
+    tri = pm.vertices_cm[pm.faces[faces]]  # (m, 3, 2)
+    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+    v0, v1 = b - a, c - a
+    den = v0[:, 0] * v1[:, 1] - v0[:, 1] * v1[:, 0]
+    rel = points_cm[:, None, :] - a[None]
+    l1 = (rel[..., 0] * v1[None, :, 1] - rel[..., 1] * v1[None, :, 0]) / den[None]
+    l2 = (v0[None, :, 0] * rel[..., 1] - v0[None, :, 1] * rel[..., 0]) / den[None]
+    bary = np.stack([1 - l1 - l2, l1, l2], axis=-1)  # (n, m, 3)
+    best = np.argmax(bary.min(axis=-1), axis=1)
+    rows = np.arange(len(points_cm))
+    bc = np.clip(bary[rows, best], 0.0, None)
+    return faces[best], bc / bc.sum(axis=1, keepdims=True)
+
+
+def place_strokes(
+    pm: PatternMesh,
+    welded: Welded,
+    strokes: Strokes,
+    surface: Surface,
+    collider: BodyCollider,
+    *,
+    lift_m: float,
+) -> Placement:
+    """Lay the triangles crossed by each pattern stroke onto the body along its (resolved) body stroke."""
+    nv = welded.n_vertices
+    acc = np.zeros((nv, 3))
+    cnt = np.zeros(nv)
+    seed = np.zeros(len(pm.faces), dtype=bool)
+    garment_face_of = np.empty(len(pm.faces), dtype=np.int64)
+    garment_face_of[welded.face_order] = np.arange(len(pm.faces))
+    tracks = []
+    path = strokes.source or None
+    for pair in strokes.pairs:
+        ps = pair.pattern
+        crossed = triangles_crossed(pm, ps)
+        if not len(crossed):
+            raise InputError(f"stroke {pair.id}: pattern stroke crosses no triangle of piece {ps.piece!r}", path)
+        k = pm.piece_names.index(ps.piece)
+        # Orientation of the piece in its cm coordinates: faces are counter-clockwise seen from the outer face.
+        f0, f1 = pm.piece_faces[k]
+        t0 = pm.vertices_cm[pm.faces[f0]]
+        d1, d2 = t0[1] - t0[0], t0[2] - t0[0]
+        side = 1.0 if d1[0] * d2[1] - d1[1] * d2[0] > 0 else -1.0
+
+        body_pts = pair.body.surface_points
+        rough = arc_length(body_pts)[-1]
+        n_path = int(np.clip(np.ceil(rough / PATH_STEP_M) + 1, 2, 2000))
+        bpath = resample_on_surface(surface, body_pts, n_path).points
+        lb = float(arc_length(bpath)[-1])
+        lp = ps.length_cm
+        if lb < 1e-3:
+            raise InputError(f"stroke {pair.id}: body stroke has zero length on the surface", path)
+
+        vids = np.unique(pm.faces[crossed])
+        s, off, _ = stroke_coordinates(pm.vertices_cm[vids], ps.points)
+        t = s / lp
+        q = interpolate_polyline(bpath, t * lb)
+        eps = min(0.01, 0.25 * lb)
+        tangent = interpolate_polyline(bpath, t * lb + eps) - interpolate_polyline(bpath, t * lb - eps)
+        on = surface.closest(q)
+        normal = smooth_normals(collider, on.faces, on.barycentric)
+        tangent -= np.einsum("ij,ij->i", tangent, normal)[:, None] * normal
+        tangent /= np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-300)
+        across = side * np.cross(normal, tangent)
+        x = on.points + (off / 100.0)[:, None] * across
+        proj = surface.closest(x)
+        nx = smooth_normals(collider, proj.faces, proj.barycentric)
+        x = proj.points + lift_m * nx
+        g = welded.vertex_of[vids]
+        np.add.at(acc, g, x)
+        np.add.at(cnt, g, 1.0)
+        seed[crossed] = True
+
+        samples = resample_polyline(ps.points, RESIDUAL_SAMPLES)
+        pf, bary = _locate(pm, crossed, samples)
+        tracks.append(StrokeTrack(pair.id, garment_face_of[pf], bary, bpath, lp / 100.0, lb))
+    placed = cnt > 0
+    pos = np.zeros((nv, 3))
+    pos[placed] = acc[placed] / cnt[placed, None]
+    return Placement(pos, placed, seed[welded.face_order], tracks)

@@ -1,0 +1,289 @@
+"""The wrap (SPEC §4.2): put a sewing pattern on a body from corresponding strokes.
+
+    from kitsuke.dressing import wrap, WrapParams
+    garment = wrap(body, pattern, strokes)                    # DressedGarment
+    garment.report.ok, garment.stroke_residual_m, garment.timings
+
+Steps (the paper's, with the interpretations of SPEC §4.2):
+
+1. **Transfer** (`_place`): the pattern triangles each pattern stroke crosses are laid on the body along its body
+   stroke (arc-length correspondence; offsets across the stroke laid out on the surface; `lift_m` off it).
+2. **Growth** (`_grow`): the rest of the garment grows ring by ring from the placed triangles, each new triangle
+   unfolded from its placed neighbour (from the cloth, not the body), with relaxation and collision between rings.
+   The stroke triangles stay pinned while the garment grows.
+3. **Seams**: the garment mesh shares the vertices of every seam from the start (`_weld`), so where two grown
+   regions meet at a seam the triangles between them are stretched and the relaxation pulls them shut,
+   progressively, ring after ring and then in a closing relaxation (without gravity) until the strain is small.
+4. **Settle**: relaxation with gravity and collision, the stroke pins released. Optionally a band of the garment
+   (e.g. where a kimono's obi goes) is held: its vertices are pinned where they are after step 3.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, relax
+from ..errors import InputError
+from ..geometry import TriMesh
+from ..geometry.surface import Surface
+from ..metrics import QualityReport, quality_report
+from ..pattern import Pattern, PatternMesh, mesh_pattern
+from ._grow import grow
+from ._place import StrokeTrack, place_strokes
+from ._weld import weld
+from .strokes import Strokes, resolve_strokes
+
+
+@dataclass(frozen=True)
+class WrapParams:
+    """Options of `wrap`; each with its unit and reason.
+
+    edge_length_cm : target edge length when `wrap` meshes a Pattern itself, cm.
+    lift_m : the transferred stroke triangles are placed this far off the body, metres (just outside the cloth's
+        contact offset, so collision does not fight the placement).
+    rings_per_relax : growth rings between relaxations (more is faster, fewer keeps growth closer to the body).
+    grow_iterations : relaxation iterations (no gravity) after each group of rings.
+    close_iterations : most iterations of the closing relaxation after growth (no gravity, strokes pinned);
+        it stops early once the largest vertex move falls below `close_tolerance_m`.
+    close_tolerance_m : metres, see close_iterations.
+    settle_iterations : relaxation iterations with gravity and collision at the end.
+    release_strokes : unpin the stroke triangles for the settle (the paper lets the garment settle freely);
+        False keeps them where the strokes put them.
+    hold_band_m : (low, high) heights in metres, or None: garment vertices in this band are pinned for the settle
+        (a kimono's waist, held by the obi).
+    cloth : ClothParams of the relaxation (gravity applies only in the settle; growth runs without it). Strain
+        limiting is off by default: where the grown garment is still strained at seams, it would drag the whole
+        garment towards its supports in one iteration (measured on the shirt: the shirt ends up a scarf).
+    """
+
+    edge_length_cm: float = 1.5
+    lift_m: float = 0.004
+    rings_per_relax: int = 1
+    grow_iterations: int = 2
+    close_iterations: int = 200
+    close_tolerance_m: float = 2e-5
+    settle_iterations: int = 60
+    release_strokes: bool = True
+    hold_band_m: tuple[float, float] | None = None
+    cloth: ClothParams = field(default_factory=lambda: ClothParams(max_stretch=None))
+
+    def __post_init__(self) -> None:
+        for name in ("rings_per_relax",):
+            if getattr(self, name) < 1:
+                raise InputError(f"wrap parameter {name} must be >= 1")
+        for name in ("grow_iterations", "close_iterations", "settle_iterations"):
+            if getattr(self, name) < 0:
+                raise InputError(f"wrap parameter {name} must be >= 0")
+        if not (self.edge_length_cm > 0 and self.lift_m >= 0 and self.close_tolerance_m >= 0):
+            raise InputError("wrap parameters edge_length_cm > 0, lift_m >= 0 and close_tolerance_m >= 0 required")
+        if self.hold_band_m is not None and not (
+            len(self.hold_band_m) == 2 and self.hold_band_m[0] < self.hold_band_m[1]
+        ):
+            raise InputError("hold_band_m must be (low, high) with low < high, metres")
+
+
+@dataclass
+class DressedGarment:
+    """A garment on a body.
+
+    Attributes
+    ----------
+    name : the pattern's name.
+    piece_names : (P,) piece names. piece_faces : (P, 2) int64, [start, stop) face range of each piece.
+    positions : (V, 3) float64, metres, world frame (Y up); seam vertices shared between pieces.
+    faces : (F, 3) int64, counter-clockwise seen from outside the garment (each piece's outer face).
+    corner_uv : (F, 3, 2) float64, metres: each corner's pattern position in its piece (SPEC §3.3 `vt`).
+    pattern_vertex : (Vp,) int64, the garment vertex of each vertex of the PatternMesh it came from.
+    model : the ClothModel (rest shape, rest lengths); pinned : (V,) bool, vertices held at the end (hold band).
+    stroke_ids : stroke ids in drawing order. stroke_residual_m : (S,) float64 metres, for each stroke the largest
+        distance of its pattern stroke (on the garment) to its body stroke after the settle.
+    stroke_length_ratio : (S,) body stroke length / pattern stroke length (1 = the stroke asks for no stretch).
+    rings : growth rings. timings : seconds per step ("mesh", "resolve", "place", "grow", "close", "settle",
+        "wrap" = all of them, "report").
+    report : the SPEC §6 quality report against the body.
+    """
+
+    name: str
+    piece_names: list[str]
+    piece_faces: np.ndarray
+    positions: np.ndarray
+    faces: np.ndarray
+    corner_uv: np.ndarray
+    pattern_vertex: np.ndarray
+    model: ClothModel = field(repr=False)
+    pinned: np.ndarray = field(repr=False)
+    stroke_ids: list[int] = field(default_factory=list)
+    stroke_residual_m: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    stroke_length_ratio: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    tracks: list[StrokeTrack] = field(default_factory=list, repr=False)
+    rings: int = 0
+    timings: dict[str, float] = field(default_factory=dict)
+    report: QualityReport | None = None
+
+    @property
+    def n_vertices(self) -> int:
+        return len(self.positions)
+
+    @property
+    def max_stroke_residual_m(self) -> float:
+        return float(self.stroke_residual_m.max(initial=0.0))
+
+    def to_trimesh(self) -> TriMesh:
+        """The garment as a TriMesh (no uv: the pattern uv is per corner, see corner_uv)."""
+        return TriMesh(self.positions, self.faces, name=self.name)
+
+    def summary(self) -> dict:
+        """JSON-ready counts, timings, stroke residuals and the quality report."""
+        return {
+            "name": self.name,
+            "vertices": self.n_vertices,
+            "faces": len(self.faces),
+            "rings": self.rings,
+            "timings_s": {k: round(v, 4) for k, v in self.timings.items()},
+            "strokes": [
+                {"id": i, "residual_mm": round(float(r) * 1e3, 2), "length_ratio": round(float(q), 4)}
+                for i, r, q in zip(self.stroke_ids, self.stroke_residual_m, self.stroke_length_ratio, strict=True)
+            ],
+            "quality": None if self.report is None else self.report.to_dict(),
+        }
+
+
+def wrap(
+    body,
+    garment: Pattern | PatternMesh,
+    strokes: Strokes,
+    *,
+    pattern: Pattern | None = None,
+    params: WrapParams | None = None,
+    collider: BodyCollider | None = None,
+    report: bool = True,
+) -> DressedGarment:
+    """Dress `body` with `garment` placed by `strokes` (SPEC §4.2); see the module docstring for the steps.
+
+    body : a `kitsuke.body.Body` (or a closed TriMesh).
+    garment : a Pattern (meshed here at `params.edge_length_cm`) or an already meshed PatternMesh.
+    strokes : stroke pairs; body strokes not yet resolved are put on the body here (`resolve_strokes`), which
+        needs the Pattern (`garment` itself, or `pattern=` with a PatternMesh).
+    collider : a prepared BodyCollider for `body` (built if None).
+    report : compute the quality report (a winding-number test; not part of the wrap's time).
+    Raises InputError for strokes naming a missing piece or crossing no triangle, a body with holes, and a
+    garment that the strokes cannot reach (a piece joined by no seam to any piece with a stroke).
+    """
+    p = params or WrapParams()
+    if not isinstance(p, WrapParams):
+        raise InputError("params must be a WrapParams")
+    if not isinstance(strokes, Strokes):
+        raise InputError("strokes must be a kitsuke.dressing.Strokes")
+    if not len(strokes):
+        raise InputError("no strokes: the wrap needs at least one stroke pair", strokes.source or None)
+    if strokes.target != "body":
+        raise InputError("wrap dresses a body: these strokes target a garment (use a re-wrap)", strokes.source or None)
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    if isinstance(garment, Pattern):
+        pattern = garment
+        pm = mesh_pattern(garment, edge_length=p.edge_length_cm)
+    elif isinstance(garment, PatternMesh):
+        pm = garment
+    else:
+        raise InputError("garment must be a Pattern or a PatternMesh")
+    mesh = body if isinstance(body, TriMesh) else body.mesh
+    t1 = time.perf_counter()
+    timings["mesh"] = t1 - t0
+    if collider is None:
+        collider = BodyCollider.from_mesh(mesh) if isinstance(body, TriMesh) else BodyCollider.from_body(body)
+    surface = Surface(mesh)
+    if not strokes.resolved:
+        if pattern is None:
+            raise InputError("strokes are not on the body yet: pass pattern= to resolve them", strokes.source or None)
+        strokes = resolve_strokes(strokes, pattern, surface, pattern_mesh=pm)
+    else:
+        for pair in strokes.pairs:
+            if pair.pattern.piece not in pm.piece_names:
+                raise InputError(
+                    f"stroke {pair.id}: pattern piece {pair.pattern.piece!r} is not in pattern {pm.name!r}",
+                    strokes.source or None,
+                )
+    t2 = time.perf_counter()
+    timings["resolve"] = t2 - t1
+
+    welded = weld(pm)
+    placement = place_strokes(pm, welded, strokes, surface, collider, lift_m=p.lift_m)
+    grow_params = dataclasses.replace(p.cloth, gravity_step_m=0.0)
+    model = ClothModel.from_corners(welded.faces, welded.rest_corners, n_vertices=welded.n_vertices, params=grow_params)
+    state = ClothState.new(model, placement.positions, pinned=placement.placed.copy(), face_active=placement.seed_faces)
+    seed_pins = placement.placed.copy()
+    t3 = time.perf_counter()
+    timings["place"] = t3 - t2
+
+    placed = placement.placed.copy()
+    # The seed faces' vertices are placed; faces whose three vertices are placed (next to a seed) join at once.
+    rings = grow(
+        model,
+        state,
+        placed,
+        lambda _ring: relax(model, state, collider, iterations=p.grow_iterations),
+        rings_per_relax=p.rings_per_relax,
+    )
+    if not state.face_active.all():
+        missing = np.flatnonzero(~state.face_active)
+        piece_of = np.searchsorted(welded.piece_faces[:, 1], missing, side="right")
+        names = sorted({pm.piece_names[i] for i in np.unique(piece_of)})
+        raise InputError(
+            f"no stroke reaches piece(s) {', '.join(names)}: draw a stroke on them or sew them to a piece that has one",
+            strokes.source or None,
+        )
+    t4 = time.perf_counter()
+    timings["grow"] = t4 - t3
+
+    done = 0
+    while done < p.close_iterations:
+        n = min(10, p.close_iterations - done)
+        st = relax(model, state, collider, iterations=n)
+        done += n
+        if st.max_step_m < p.close_tolerance_m:
+            break
+    t5 = time.perf_counter()
+    timings["close"] = t5 - t4
+
+    settle = model.with_params(p.cloth)
+    pins = np.zeros(model.n_vertices, dtype=bool) if p.release_strokes else seed_pins.copy()
+    if p.hold_band_m is not None:
+        y = state.positions[:, 1]
+        pins |= (y >= p.hold_band_m[0]) & (y <= p.hold_band_m[1])
+    state.pinned = pins
+    if p.settle_iterations:
+        relax(settle, state, collider, iterations=p.settle_iterations)
+    t6 = time.perf_counter()
+    timings["settle"] = t6 - t5
+    timings["wrap"] = t6 - t0
+
+    residual = np.array([tr.residual_m(state.positions, model.faces) for tr in placement.tracks])
+    ratio = np.array([tr.body_length_m / tr.pattern_length_m for tr in placement.tracks])
+    result = DressedGarment(
+        name=pm.name,
+        piece_names=list(pm.piece_names),
+        piece_faces=welded.piece_faces,
+        positions=state.positions,
+        faces=model.faces,
+        corner_uv=welded.rest_corners,
+        pattern_vertex=welded.vertex_of,
+        model=settle,
+        pinned=pins,
+        stroke_ids=[tr.id for tr in placement.tracks],
+        stroke_residual_m=residual,
+        stroke_length_ratio=ratio,
+        tracks=placement.tracks,
+        rings=rings,
+        timings=timings,
+    )
+    if report:
+        result.report = quality_report(
+            state.positions, model.faces, mesh, rest_lengths=model.rest_lengths, rest_areas=model.rest_areas
+        )
+        timings["report"] = time.perf_counter() - t6
+    return result
