@@ -7,28 +7,17 @@ Prints one line per measurement: the median of several runs after a warm-up.
 
 from __future__ import annotations
 
-import statistics
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
+from _timing import timeit
 
 from kitsuke.body import default_body, load_body
 from kitsuke.geometry import load_mesh, save_mesh
 
 ROOT = Path(__file__).resolve().parents[1]
 MEAN_ALL = ROOT / "tests" / "data" / "bodies" / "mean_all.obj"
-
-
-def timeit(fn, repeat: int = 7) -> float:
-    fn()
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
 
 
 def main() -> None:

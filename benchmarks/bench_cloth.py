@@ -17,6 +17,7 @@ import os
 import time
 
 import numpy as np
+from _timing import timeit as _timeit
 
 from kitsuke.body import default_body
 from kitsuke.cloth import (
@@ -35,14 +36,8 @@ from kitsuke.metrics import penetration, quality_report
 
 
 def timeit(fn, repeat: int = 7) -> float:
-    """Best wall time of `repeat` calls after one warm-up call, seconds."""
-    fn()
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return min(times)
+    """Best of `repeat` calls (this host is noisy), seconds."""
+    return _timeit(fn, repeat, stat="min")
 
 
 def setup(body, shuffle: bool = False, reorder: bool = False):

@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import argparse
 import os
-import statistics
 import time
 from pathlib import Path
+
+from _timing import timeit
 
 SHARED_BODY = Path(__file__).resolve().parents[2] / "shared/data/bodies/garmentcode/mean_all.obj"
 
@@ -31,13 +32,7 @@ def bench_mesh():
 
 
 def median_ms(fn, frames: int) -> float:
-    fn()  # warm-up
-    times = []
-    for _ in range(frames):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times) * 1000.0
+    return timeit(fn, frames) * 1000.0
 
 
 def main() -> None:

@@ -12,20 +12,12 @@ from __future__ import annotations
 import time
 
 import numpy as np
+from _timing import timeit
 
 from kitsuke.body import default_body
 from kitsuke.dressing import PatternStroke, load_packaged_strokes, resolve_strokes, triangles_crossed
 from kitsuke.geometry.surface import Surface
 from kitsuke.pattern import make_kimono, mesh_pattern
-
-
-def best(fn, repeat=5):
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return min(times)
 
 
 def main() -> None:
@@ -43,27 +35,32 @@ def main() -> None:
     print(f"resolve packaged strokes, cold (AABB + embree scene built): {cold:.1f} ms")
     surf = Surface(body.mesh)
     resolve_strokes(strokes, pattern, surf, pattern_mesh=pm)
-    ms = 1e3 * best(lambda: resolve_strokes(strokes, pattern, surf, pattern_mesh=pm))
+    ms = 1e3 * timeit(lambda: resolve_strokes(strokes, pattern, surf, pattern_mesh=pm), stat="min", warmup=False)
     print(f"resolve packaged strokes, warm Surface, with pattern-mesh checks: {ms:.1f} ms")
-    ms = 1e3 * best(lambda: resolve_strokes(strokes, pattern, surf))
+    ms = 1e3 * timeit(lambda: resolve_strokes(strokes, pattern, surf), stat="min", warmup=False)
     print(f"resolve packaged strokes, warm Surface, no pattern mesh: {ms:.1f} ms")
 
     v = body.mesh.vertices
     near = v[rng.integers(0, len(v), 10_000)] + rng.normal(scale=0.01, size=(10_000, 3))
     far = rng.normal(size=(10_000, 3)) * 5.0
-    print(f"closest, 10k points within ~1 cm: {1e3 * best(lambda: surf.closest(near)):.1f} ms")
-    print(f"closest, 10k points metres away: {1e3 * best(lambda: surf.closest(far)):.1f} ms")
+    print(
+        f"closest, 10k points within ~1 cm: {1e3 * timeit(lambda: surf.closest(near), stat='min', warmup=False):.1f} ms"
+    )
+    print(
+        f"closest, 10k points metres away: {1e3 * timeit(lambda: surf.closest(far), stat='min', warmup=False):.1f} ms"
+    )
 
     n = 100_000
     o = np.c_[rng.uniform(-0.2, 0.2, n), rng.uniform(0.9, 1.4, n), np.full(n, 2.0)]
     d = np.tile([0.0, 0.0, -1.0], (n, 1))
-    print(f"cast 100k rays through the torso, first hit: {1e3 * best(lambda: surf.cast(o, d), 3):.0f} ms")
-    ms = 1e3 * best(lambda: surf.cast(o, d, hit="last"), 3)
+    ms = 1e3 * timeit(lambda: surf.cast(o, d), 3, stat="min", warmup=False)
+    print(f"cast 100k rays through the torso, first hit: {ms:.0f} ms")
+    ms = 1e3 * timeit(lambda: surf.cast(o, d, hit="last"), 3, stat="min", warmup=False)
     print(f"cast 100k rays through the torso, last hit: {ms:.0f} ms")
 
     y = np.linspace(170, 300, 200)
     stroke = PatternStroke("migoro_left", np.c_[15 + 5 * np.sin(y / 10), y])
-    ms = 1e3 * best(lambda: triangles_crossed(pm, stroke))
+    ms = 1e3 * timeit(lambda: triangles_crossed(pm, stroke), stat="min", warmup=False)
     print(
         f"triangles_crossed, 200-point stroke on a {pm.piece_faces[1, 1] - pm.piece_faces[1, 0]}-face piece: "
         f"{ms:.1f} ms ({len(triangles_crossed(pm, stroke))} faces)"
