@@ -1,0 +1,133 @@
+"""Outputs of a dressed garment (SPEC §3.3): the checkable OBJ, a GLB for viewers, the JSON report, PNG views.
+
+OBJ: `v` world positions (metres); `vt` = each corner's pattern position in metres, piece-local, not normalised (so
+rest lengths can be recovered); `f v/vt`; seam vertices shared (one `v`, a `vt` per side); one comment line
+`# kitsuke piece <name> <first_face> <last_face>` per piece (faces counted from 0, last included).
+GLB: the same surface split where its UVs differ, UVs normalised to the texture tile, double-sided material,
+optionally the body as a second mesh.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .._files import write_json_atomic, write_text_atomic
+from ..errors import InputError
+from ..geometry import TriMesh, save_mesh
+from .wrap import DressedGarment
+
+PIECE_TAG = "kitsuke piece"
+
+
+@dataclass
+class GarmentFile:
+    """A dressed garment read back from its OBJ (enough to carry on: drag, re-wrap, measure).
+
+    positions : (V, 3) float64 m. faces : (F, 3) int64. corner_uv : (F, 3, 2) float64, pattern metres.
+    piece_names : (P,) names. piece_faces : (P, 2) int64 [start, stop) face ranges.
+    """
+
+    positions: np.ndarray
+    faces: np.ndarray
+    corner_uv: np.ndarray
+    piece_names: list[str]
+    piece_faces: np.ndarray
+
+    @property
+    def rest_edge_lengths(self) -> np.ndarray:
+        """(F, 3) float64 metres: rest length of each face's edges (0-1, 1-2, 2-0) from the pattern."""
+        uv = self.corner_uv
+        return np.linalg.norm(uv[:, [1, 2, 0]] - uv, axis=2)
+
+
+def garment_obj_text(garment: DressedGarment) -> str:
+    """The SPEC §3.3 OBJ of a dressed garment, as text."""
+    out = io.StringIO()
+    out.write(f"# kitsuke dressed garment {garment.name}\n# v: world metres (Y up); vt: pattern metres, piece-local\n")
+    for name, (a, b) in zip(garment.piece_names, garment.piece_faces, strict=True):
+        out.write(f"# {PIECE_TAG} {name} {int(a)} {int(b) - 1}\n")
+    np.savetxt(out, garment.positions, fmt="v %.7f %.7f %.7f")
+    np.savetxt(out, garment.corner_uv.reshape(-1, 2), fmt="vt %.7f %.7f")
+    f = garment.faces + 1
+    t = np.arange(1, 3 * len(f) + 1).reshape(-1, 3)
+    np.savetxt(out, np.stack([f, t], axis=2).reshape(-1, 6), fmt="f %d/%d %d/%d %d/%d")
+    return out.getvalue()
+
+
+def write_garment_obj(garment: DressedGarment, path: str | os.PathLike[str]) -> Path:
+    """Write the SPEC §3.3 OBJ atomically."""
+    return write_text_atomic(path, garment_obj_text(garment))
+
+
+def read_garment_obj(path: str | os.PathLike[str]) -> GarmentFile:
+    """Read a dressed garment OBJ written by kitsuke (or any OBJ whose vt are pattern metres).
+
+    Raises InputError naming the file when it has no `vt` on every corner or holds NaN.
+    """
+    from ..geometry.obj import read_obj
+
+    data = read_obj(path)
+    if data.uv is None or data.face_uv is None or (data.face_uv < 0).any():
+        raise InputError("not a dressed garment: every face corner needs a vt (its pattern position)", path)
+    if not (np.isfinite(data.vertices).all() and np.isfinite(data.uv).all()):
+        raise InputError("holds NaN or infinite coordinates", path)
+    names, ranges = [], []
+    for line in data.comments:
+        if line.startswith(PIECE_TAG + " "):
+            try:
+                name, first, last = line[len(PIECE_TAG) + 1 :].rsplit(" ", 2)
+                names.append(name)
+                ranges.append((int(first), int(last) + 1))
+            except ValueError:
+                raise InputError(f"bad piece line {line!r}", path) from None
+    if not names:
+        names, ranges = ["garment"], [(0, len(data.faces))]
+    piece_faces = np.array(ranges, dtype=np.int64)
+    if piece_faces.min() < 0 or piece_faces.max() > len(data.faces):
+        raise InputError("a piece line names faces the file does not have", path)
+    return GarmentFile(data.vertices, data.faces, data.uv[data.face_uv], names, piece_faces)
+
+
+def garment_glb_mesh(garment: DressedGarment, *, tile_m: float = 1.0, texture: np.ndarray | None = None) -> TriMesh:
+    """The garment as a TriMesh for viewers: vertices split where corners disagree on uv; uv = pattern / tile_m."""
+    corner_v = garment.faces.reshape(-1)
+    corner_uv = garment.corner_uv.reshape(-1, 2)
+    key = np.concatenate([corner_v[:, None].astype(np.float64), np.round(corner_uv, 9)], axis=1)
+    uniq, inverse = np.unique(key, axis=0, return_inverse=True)
+    vertices = garment.positions[uniq[:, 0].astype(np.int64)]
+    return TriMesh(vertices, inverse.reshape(-1, 3), uniq[:, 1:] / tile_m, name=garment.name, texture=texture)
+
+
+def write_garment_glb(
+    garment: DressedGarment,
+    path: str | os.PathLike[str],
+    *,
+    body: TriMesh | None = None,
+    texture: np.ndarray | None = None,
+    tile_m: float = 1.0,
+) -> Path:
+    """Write a GLB: the double-sided garment (texture repeating every `tile_m` metres of pattern) and the body."""
+    meshes = [garment_glb_mesh(garment, tile_m=tile_m, texture=texture)]
+    if body is not None:
+        meshes.append(TriMesh(body.vertices, body.faces, name="body"))
+    return save_mesh(meshes, path)
+
+
+def write_garment_report(garment: DressedGarment, path: str | os.PathLike[str]) -> Path:
+    """Write `garment.summary()` (counts, timings, stroke residuals, SPEC §6 quality) as JSON."""
+    return write_json_atomic(path, garment.summary())
+
+
+def write_garment_png(
+    garment: DressedGarment, body: TriMesh, path: str | os.PathLike[str], *, size: tuple[int, int] = (500, 640)
+) -> Path:
+    """Write a labelled front / side / back sheet of the garment on the body."""
+    from ..render import render_sheet, write_png
+
+    mesh = garment_glb_mesh(garment)
+    return write_png(path, render_sheet([body, TriMesh(mesh.vertices, mesh.faces, name=garment.name)], size=size))

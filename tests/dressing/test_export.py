@@ -1,0 +1,94 @@
+"""`kitsuke dress` end to end on the shipped shirt case, and the SPEC §3.3 outputs read back."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from kitsuke.dressing.export import read_garment_obj
+from kitsuke.errors import InputError
+from kitsuke.geometry import load_mesh
+from kitsuke.pattern import load_pattern
+
+ROOT = Path(__file__).resolve().parents[2]
+SHIRT = ROOT / "tests" / "data" / "pattern" / "shirt_mean_specification.json"
+MEAN_ALL = ROOT / "tests" / "data" / "bodies" / "mean_all.obj"
+SHIRT_STROKES = ROOT / "src" / "kitsuke" / "assets" / "strokes" / "shirt_mean_all.json"
+
+
+@pytest.fixture(scope="module")
+def dressed(tmp_path_factory):
+    from kitsuke.cli import main
+
+    out = tmp_path_factory.mktemp("dress")
+    files = {k: out / f"shirt.{k}" for k in ("glb", "obj", "json", "png")}
+    inputs = ["--body", str(MEAN_ALL), "--pattern", str(SHIRT), "--strokes", str(SHIRT_STROKES)]
+    outputs = ["-o", files["glb"], "--obj", files["obj"], "--report", files["json"], "--png", files["png"]]
+    code = main(["dress", *inputs, *map(str, outputs)])
+    assert code == 0
+    return files
+
+
+def test_obj_has_pattern_rest_shape_pieces_and_shared_seams(dressed):
+    g = read_garment_obj(dressed["obj"])
+    pattern = load_pattern(SHIRT)
+    assert g.piece_names == [p.name for p in pattern.pieces]
+    assert g.piece_faces[0, 0] == 0 and g.piece_faces[-1, 1] == len(g.faces)
+    assert (g.piece_faces[1:, 0] == g.piece_faces[:-1, 1]).all()
+    # vt is the pattern in metres: each piece's vt area equals the piece's area (within the meshing's 0.5 %).
+    for name, (a, b) in zip(g.piece_names, g.piece_faces):
+        uv = g.corner_uv[a:b]
+        e1, e2 = uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]
+        area_m2 = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]).sum()
+        assert area_m2 == pytest.approx(pattern.piece(name).area * 1e-4, rel=0.005), name
+    # Seams are shared vertices: fewer vertices than corners' distinct uv, and no open seam (every piece touches
+    # another piece through a shared vertex).
+    owner = np.full(len(g.positions), -1)
+    for k, (a, b) in enumerate(g.piece_faces):
+        for v in np.unique(g.faces[a:b]):
+            owner[v] = k if owner[v] in (-1, k) else -2
+    assert (owner == -2).sum() > 50
+    # Rest lengths from vt are what the report's strain is measured against: positive and centimetre-sized.
+    rest = g.rest_edge_lengths
+    assert rest.min() > 0.001 and 0.01 < np.median(rest) < 0.02
+
+
+def test_report_glb_and_png(dressed):
+    report = json.loads(dressed["json"].read_text())
+    q = report["quality"]
+    assert q["penetration_count"] == 0 and q["seam_gap_mm"] == 0.0
+    assert report["vertices"] == len(read_garment_obj(dressed["obj"]).positions)
+    glb = load_mesh(dressed["glb"])  # garment + body in one scene
+    assert glb.n_faces == len(read_garment_obj(dressed["obj"]).faces) + load_mesh(MEAN_ALL).n_faces
+    img = np.asarray(Image.open(dressed["png"]).convert("RGB")).astype(int)
+    blue = (img[..., 2] > img[..., 0] + 40).mean()  # the garment's colour differs from skin and background
+    assert 0.01 < blue < 0.5
+
+
+def test_dress_bad_input_is_exit_2_and_writes_nothing(run_cli, tmp_path):
+    strokes = json.loads(SHIRT_STROKES.read_text())
+    strokes["pairs"][0]["pattern"]["piece"] = "no_such_piece"
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(strokes))
+    out = tmp_path / "x.glb"
+    cases = [
+        (["--strokes", str(bad)], "no_such_piece"),
+        (["--strokes", str(tmp_path / "missing.json")], "missing.json"),
+        (["--strokes", str(SHIRT_STROKES), "--obj", str(SHIRT)], "must end in .obj"),
+    ]
+    for extra, needle in cases:
+        r = run_cli("dress", "--body", MEAN_ALL, "--pattern", SHIRT, "-o", out, *extra)
+        assert r.code == 2, (extra, r.err)
+        assert needle in r.err and len(r.err.strip().splitlines()) == 1 and "Traceback" not in r.err
+        assert not out.exists()
+
+
+def test_read_garment_obj_rejects_plain_meshes(tmp_path):
+    p = tmp_path / "plain.obj"
+    p.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    with pytest.raises(InputError, match="needs a vt"):
+        read_garment_obj(p)
