@@ -88,6 +88,26 @@ def smooth_normals(collider: BodyCollider, faces: np.ndarray, bary: np.ndarray) 
     return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
 
 
+def _extended_coordinates(points_cm: np.ndarray, stroke_cm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Like `stroke_coordinates` (s along, signed offset across, cm), but with the stroke continued straight past
+    its ends: a point before the start gets s < 0 and its offset from the first segment's line, a point after the
+    end s > length. (Clamping s there, as `stroke_coordinates` does, folds those points onto the end's normal
+    line: measured on the shirt, edges of the transferred triangles strained up to 88 %.)"""
+    s, off, _ = stroke_coordinates(points_cm, stroke_cm)
+    length = float(arc_length(stroke_cm)[-1])
+    for end, origin, d in (
+        (0, stroke_cm[0], stroke_cm[1] - stroke_cm[0]),
+        (1, stroke_cm[-1], stroke_cm[-1] - stroke_cm[-2]),
+    ):
+        d = d / max(float(np.hypot(*d)), 1e-300)
+        rel = points_cm - origin
+        along = rel @ d
+        out = along < 0 if end == 0 else along > 0
+        s = np.where(out, (0.0 if end == 0 else length) + along, s)
+        off = np.where(out, d[0] * rel[:, 1] - d[1] * rel[:, 0], off)
+    return s, off
+
+
 def _locate(pm: PatternMesh, faces: np.ndarray, points_cm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The face among `faces` holding each 2D point (the best one if on none) and its barycentric coordinates."""
     tri = pm.vertices_cm[pm.faces[faces]]  # (m, 3, 2)
@@ -144,17 +164,21 @@ def place_strokes(
             raise InputError(f"stroke {pair.id}: body stroke has zero length on the surface", path)
 
         vids = np.unique(pm.faces[crossed])
-        s, off, _ = stroke_coordinates(pm.vertices_cm[vids], ps.points)
+        s, off = _extended_coordinates(pm.vertices_cm[vids], np.asarray(ps.points, dtype=np.float64))
         t = s / lp
-        q = interpolate_polyline(bpath, t * lb)
+        inside = np.clip(t, 0.0, 1.0) * lb
+        q = interpolate_polyline(bpath, inside)
         eps = min(0.01, 0.25 * lb)
-        tangent = interpolate_polyline(bpath, t * lb + eps) - interpolate_polyline(bpath, t * lb - eps)
+        tangent = interpolate_polyline(bpath, inside + eps) - interpolate_polyline(bpath, inside - eps)
         on = surface.closest(q)
         normal = smooth_normals(collider, on.faces, on.barycentric)
         tangent -= np.einsum("ij,ij->i", tangent, normal)[:, None] * normal
         tangent /= np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-300)
         across = side * np.cross(normal, tangent)
-        x = on.points + (off / 100.0)[:, None] * across
+        # Beyond its ends the stroke is continued straight along its end tangent (metres of body per metre of
+        # pattern: lb / lp), so the crossed triangles that stick out past an end keep their shape.
+        beyond = (t - np.clip(t, 0.0, 1.0)) * lb
+        x = on.points + beyond[:, None] * tangent + (off / 100.0)[:, None] * across
         proj = surface.closest(x)
         nx = smooth_normals(collider, proj.faces, proj.barycentric)
         x = proj.points + lift_m * nx

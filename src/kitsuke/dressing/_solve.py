@@ -1,0 +1,109 @@
+"""Wrap step 3: closing the grown garment with a global (local/global, "as-rigid-as-possible") relaxation.
+
+Why not only `kitsuke.cloth.relax`: its Jacobi averaging moves each vertex towards the mean of its triangles'
+goals, so a distortion spread over the whole garment (pieces grown from different strokes meeting at a seam
+with a gap of centimetres) diffuses out one ring per iteration. Measured on the shirt at 1.5 cm: after growth
+the edge strain is 15 % mean; 200 iterations of `relax` leave 11 %, and 1200 iterations without any collider
+still leave 2.6 % mean and 58 % max.
+
+Here each iteration (1) fits every triangle's rest shape to its current corners (the same kernel as `relax`:
+`shape_match_goals`, with un-flipping), then (2) solves one sparse linear system for all vertices at once so
+that every triangle edge best matches its goal edge (least squares; the matrix is a graph Laplacian plus a
+proximal term, factorised once), then (3) runs the collision update. Pinned vertices stay where they are.
+A handful of iterations removes the large-scale distortion that `relax` needs thousands for. What it does not
+remove: the collision is applied after each solve, not inside it, so where the solve pulls cloth into the body
+(the shirt's armpits) the two alternate by millimetres; measured on the shirt the strain plateaus at ~3 % mean
+after 40 iterations (120 iterations: 3.1 %). Holding the contacts inside the solve (a heavier proximal weight,
+refactorised when contacts change) did not help: weight 0.2 gave 4.6 % instead of 4.9 %, weight 1 tore it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..cloth import BodyCollider, ClothModel, ClothState, collide
+from ..cloth import _kernels as K
+
+#: Weight of the proximal term (each vertex held towards where it is), relative to one triangle edge's weight:
+#: small, it only keeps the system well posed and damps the fight with collision.
+PROXIMAL = 0.02
+#: Weight of a pinned vertex (effectively fixed; they are also reset exactly after each solve).
+PINNED = 1e6
+
+
+class GlobalRelax:
+    """A factorised local/global relaxation of `model`.
+
+    pinned : (V,) bool, vertices that do not move. held : (V,) bool or None, vertices pulled towards `targets`
+    (V, 3) metres with `hold_weight` (relative to one triangle edge's weight; soft: the garment may yield where
+    the strokes ask for more than it can give). Uses `model.params.unflip` and the collider's contact offset;
+    no gravity, no friction: it closes seams and removes strain, the gravity settle stays with `relax`.
+    All faces must be active (it runs after growth).
+    """
+
+    def __init__(
+        self,
+        model: ClothModel,
+        pinned: np.ndarray,
+        held: np.ndarray | None = None,
+        targets: np.ndarray | None = None,
+        hold_weight: float = 1.0,
+    ):
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.linalg import splu
+
+        self.model = model
+        f = model.faces
+        nv = model.n_vertices
+        self.i = f.reshape(-1)  # corner k of face t -> edge (k, k+1)
+        self.j = np.roll(f, -1, axis=1).reshape(-1)
+        ones = np.ones(len(self.i))
+        diag = np.bincount(self.i, minlength=nv) + np.bincount(self.j, minlength=nv)
+        self.anchor = np.where(pinned, PINNED, PROXIMAL).astype(np.float64)
+        self.held = np.zeros(nv, dtype=bool) if held is None else held & ~pinned
+        self.anchor[self.held] = hold_weight
+        self.targets = None if targets is None else np.asarray(targets, dtype=np.float64).copy()
+        rows = np.concatenate([self.i, self.j, np.arange(nv)])
+        cols = np.concatenate([self.j, self.i, np.arange(nv)])
+        vals = np.concatenate([-ones, -ones, diag + self.anchor])
+        a = coo_matrix((vals, (rows, cols)), shape=(nv, nv)).tocsc()
+        self.lu = splu(a)
+        self.pinned = pinned.copy()
+        nf = model.n_faces
+        self._normals = np.zeros((nf, 3))
+        self._ref = np.zeros((nf, 3))
+        self._flipped = np.zeros(nf, dtype=np.uint8)
+        self._goals = np.zeros((nf, 3, 3))
+
+    def step(self, state: ClothState, collider: BodyCollider | None) -> float:
+        """One local/global iteration (in place on `state`); returns the largest vertex move, metres."""
+        m = self.model
+        pos = state.positions
+        K.reference_normals(
+            pos,
+            m.faces,
+            m.face_adjacency,
+            m.face_adjacency_sign,
+            state.face_active,
+            m.params.unflip,
+            self._normals,
+            self._ref,
+            self._flipped,
+        )
+        K.shape_match_goals(pos, m.faces, m.rest_corners, self._ref, state.face_active, self._goals)
+        g = self._goals
+        d = (g - np.roll(g, -1, axis=1)).reshape(-1, 3)  # goal edge vectors, ordered like self.i / self.j
+        nv = m.n_vertices
+        rhs = self.anchor[:, None] * pos
+        if self.targets is not None:
+            rhs[self.held] = self.anchor[self.held, None] * self.targets[self.held]
+        for c in range(3):
+            rhs[:, c] += np.bincount(self.i, weights=d[:, c], minlength=nv)
+            rhs[:, c] -= np.bincount(self.j, weights=d[:, c], minlength=nv)
+        new = self.lu.solve(rhs)
+        new[self.pinned] = pos[self.pinned]
+        move = float(np.sqrt(((new - pos) ** 2).sum(axis=1)).max(initial=0.0))
+        pos[:] = new
+        if collider is not None:
+            collide(m, state, collider)
+        return move
