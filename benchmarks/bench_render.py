@@ -73,9 +73,7 @@ def main() -> None:
     print(f"  contact sheet front/side/back 3x400x500: {sheet_ms:.0f} ms")
 
     # Where the time goes at the default size: CPU-side preparation vs the GPU (llvmpipe) work.
-    from kitsuke.render.offscreen import _smooth_normals
-
-    prep = median_ms(lambda: _smooth_normals(mesh.vertices, mesh.faces), args.frames)
+    prep = median_ms(lambda: mesh.vertex_normals, args.frames)
     print(f"  of which vertex normals (numpy): {prep:.1f} ms")
     renderer.close()
 
