@@ -199,3 +199,24 @@ def test_sheet_partly_inside_the_default_body_ends_outside(body, body_collider):
     relax(model, state, body_collider, iterations=60)
     pen = penetration(state.positions, body.mesh)
     assert pen.count == 0 and pen.deepest_mm <= 2.0
+
+
+def test_floor_keeps_cloth_above_the_ground_and_pins_still(sphere):
+    collider = BodyCollider.from_mesh(sphere, floor_y=-0.2)
+    pts = np.array(
+        [[0.5, -0.5, 0.0], [0.6, -0.199, 0.0], [0.7, -0.3, 0.0], [0.8, 0.4, 0.0], [0.9, 0.0, 0.0], [1, 1, 1.0]]
+    )
+    model, state = point_cloud_model(pts)
+    state.pinned[2] = True
+    collide(model, state, collider)
+    offset = model.params.contact_offset_m
+    np.testing.assert_allclose(state.positions[[0, 1], 1], -0.2 + offset)
+    np.testing.assert_array_equal(state.positions[2:], pts[2:])  # pinned, and above the floor
+    np.testing.assert_array_equal(state.positions[:, [0, 2]], pts[:, [0, 2]])  # straight up, not sideways
+
+
+def test_from_body_puts_the_floor_under_the_feet(body, body_collider):
+    assert body_collider.floor_y == pytest.approx(body.mesh.vertices[:, 1].min())
+    assert BodyCollider.from_body(body, floor=False).floor_y is None
+    with pytest.raises(InputError, match="floor_y"):
+        BodyCollider.from_mesh(body.mesh, floor_y=float("nan"))

@@ -44,6 +44,8 @@ class BodyCollider:
     face_adjacency : (Fb, 3) int64, face across each local edge. faces_at_ptr, faces_at : CSR of the faces around
         each vertex (for the walk).
     capsule_ends : (C, 2, 3) float64, metres; capsule_radii : (C, 2) float64, metres (tapered capsules).
+    floor_y : height of the ground plane, metres, or None: cloth is kept above it (a long hem rests on the floor
+        instead of hanging through it). `from_body` puts it under the feet.
     """
 
     vertices: np.ndarray
@@ -51,6 +53,7 @@ class BodyCollider:
     capsule_ends: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 3)))
     capsule_radii: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     source: str | None = None
+    floor_y: float | None = None
     face_normals: np.ndarray = field(init=False, repr=False)
     edge_normals: np.ndarray = field(init=False, repr=False)
     vertex_normals: np.ndarray = field(init=False, repr=False)
@@ -66,6 +69,7 @@ class BodyCollider:
         capsule_ends: np.ndarray | None = None,
         capsule_radii: np.ndarray | None = None,
         source: str | None = None,
+        floor_y: float | None = None,
     ) -> BodyCollider:
         """Collider for a closed mesh; capsules optional ((C, 2, 3) ends and (C, 2) radii, metres).
 
@@ -80,14 +84,18 @@ class BodyCollider:
             raise InputError("capsule ends and radii must be finite, radii >= 0")
         if len(ends) > 63:
             raise InputError(f"at most 63 capsules are supported, got {len(ends)}")
-        return cls(mesh.vertices, mesh.faces, ends, radii, source)
+        if floor_y is not None and not np.isfinite(floor_y):
+            raise InputError(f"floor_y must be a finite height in metres or None, got {floor_y!r}")
+        return cls(mesh.vertices, mesh.faces, ends, radii, source, None if floor_y is None else float(floor_y))
 
     @classmethod
-    def from_body(cls, body, posed=None, *, capsules: bool = True) -> BodyCollider:
-        """Collider for a `kitsuke.body.Body`, in its rest pose or in `posed` (a PosedBody), with its capsules."""
+    def from_body(cls, body, posed=None, *, capsules: bool = True, floor: bool = True) -> BodyCollider:
+        """Collider for a `kitsuke.body.Body`, in its rest pose or in `posed` (a PosedBody), with its capsules and
+        (`floor`) the ground plane under the rest pose's lowest point (the soles)."""
         mesh = body.mesh if posed is None else body.posed_mesh(posed)
         ends, radii = body.capsule_segments(posed) if capsules else (None, None)
-        return cls.from_mesh(mesh, capsule_ends=ends, capsule_radii=radii, source=body.source or None)
+        floor_y = float(body.mesh.vertices[:, 1].min()) if floor else None
+        return cls.from_mesh(mesh, capsule_ends=ends, capsule_radii=radii, source=body.source or None, floor_y=floor_y)
 
     def __post_init__(self) -> None:
         v = np.ascontiguousarray(self.vertices, dtype=np.float64)
@@ -140,7 +148,9 @@ class BodyCollider:
         large move so that far cloth vertices are searched again.
         """
         ends = self.capsule_ends if capsule_ends is None else capsule_ends
-        return BodyCollider(np.asarray(vertices, dtype=np.float64), self.faces, ends, self.capsule_radii, self.source)
+        return BodyCollider(
+            np.asarray(vertices, dtype=np.float64), self.faces, ends, self.capsule_radii, self.source, self.floor_y
+        )
 
     def nearest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Global nearest-surface query (libigl AABB, built once): face (n,) int64, point (n, 3), distance (n,)."""
@@ -289,4 +299,8 @@ def collide(model: ClothModel, state: ClothState, collider: BodyCollider) -> Col
     searches = track(model, state, collider, active=act)
     c = state.contacts
     pushed, deepest = K.push_out(pos, movable, p.contact_offset_m, c.face, c.normal, c.distance)
+    if collider.floor_y is not None:
+        low = movable & (pos[:, 1] < collider.floor_y + p.contact_offset_m)
+        pos[low, 1] = collider.floor_y + p.contact_offset_m
+        pushed += int(low.sum())
     return CollisionStats(searches, int(pushed), float(deepest))

@@ -29,6 +29,10 @@ from ..cloth import _kernels as K
 PROXIMAL = 0.02
 #: Weight of a pinned vertex (effectively fixed; they are also reset exactly after each solve).
 PINNED = 1e6
+#: Most conjugate-gradient iterations per contact solve: an inexact solve is enough inside the outer iteration
+#: (each starts from the last positions). Measured on the kimono: 8 leave 2.1 % mean strain where 40 leave
+#: 1.8 %; the solve stops early when converged.
+CG_ITERATIONS = 40
 
 
 class GlobalRelax:
@@ -48,6 +52,8 @@ class GlobalRelax:
         held: np.ndarray | None = None,
         targets: np.ndarray | None = None,
         hold_weight: float = 1.0,
+        contact_weight: float = 0.0,
+        gravity_m: float = 0.0,
     ):
         from scipy.sparse import coo_matrix
         from scipy.sparse.linalg import splu
@@ -68,6 +74,11 @@ class GlobalRelax:
         vals = np.concatenate([-ones, -ones, diag + self.anchor])
         a = coo_matrix((vals, (rows, cols)), shape=(nv, nv)).tocsc()
         self.lu = splu(a)
+        self.a = a.tocsr()
+        self.contact_weight = float(contact_weight)
+        self.gravity_m = float(gravity_m)
+        self.released = np.zeros(nv, dtype=bool)
+        self.cg_iterations = 0
         self.pinned = pinned.copy()
         nf = model.n_faces
         self._normals = np.zeros((nf, 3))
@@ -100,10 +111,70 @@ class GlobalRelax:
         for c in range(3):
             rhs[:, c] += np.bincount(self.i, weights=d[:, c], minlength=nv)
             rhs[:, c] -= np.bincount(self.j, weights=d[:, c], minlength=nv)
-        new = self.lu.solve(rhs)
+        if self.gravity_m:
+            rhs[:, 1] -= self.anchor * self.gravity_m
+        if self.contact_weight > 0 and collider is not None:
+            p = m.params
+            new = self._solve_with_contacts(state, rhs, collider, p.contact_offset_m, p.contact_distance_m)
+        else:
+            new = self.lu.solve(rhs)
         new[self.pinned] = pos[self.pinned]
         move = float(np.sqrt(((new - pos) ** 2).sum(axis=1)).max(initial=0.0))
         pos[:] = new
         if collider is not None:
             collide(m, state, collider)
         return move
+
+    def _solve_with_contacts(
+        self, state: ClothState, rhs: np.ndarray, collider: BodyCollider, offset: float, reach: float
+    ) -> np.ndarray:
+        """Solve (A + sum_c w n_c n_c^T) x = rhs + sum_c w n_c (n_c . q_c): the body contacts as planes inside the
+        global step (normal direction only, so cloth still slides along the body), with conjugate gradients
+        preconditioned by the factorised A. A contact whose vertex the solve pulls off the body (outwards past
+        its plane) is released for the next iteration: the plane only pushes, never glues.
+        """
+        c = state.contacts
+        touching = (c.face >= 0) & (c.distance < reach) & ~self.pinned
+        self.released &= touching
+        idx = np.flatnonzero(touching & ~self.released)
+        n = c.normal[idx]
+        q = c.point[idx] + offset * n
+        if collider.floor_y is not None:  # the floor: one more plane for the vertices near it
+            low = np.flatnonzero((state.positions[:, 1] < collider.floor_y + reach) & ~self.pinned)
+            idx = np.concatenate([idx, low])
+            n = np.concatenate([n, np.tile([0.0, 1.0, 0.0], (len(low), 1))])
+            q = np.concatenate([q, np.tile([0.0, collider.floor_y + offset, 0.0], (len(low), 1))])
+        if not len(idx):
+            return self.lu.solve(rhs)
+        w = self.contact_weight
+        b = rhs.copy()
+        np.add.at(b, idx, w * n * (n * q).sum(axis=1, keepdims=True))
+
+        def apply(x: np.ndarray) -> np.ndarray:
+            y = self.a @ x
+            np.add.at(y, idx, w * n * (n * x[idx]).sum(axis=1, keepdims=True))
+            return y
+
+        x = state.positions.copy()
+        r = b - apply(x)
+        z = self.lu.solve(r)
+        p = z.copy()
+        rz = float((r * z).sum())
+        tol = 1e-10 * float((b * b).sum())
+        it = 0
+        for it in range(CG_ITERATIONS):  # noqa: B007 (counted below)
+            ap = apply(p)
+            alpha = rz / float((p * ap).sum())
+            x += alpha * p
+            r -= alpha * ap
+            if float((r * r).sum()) < tol:
+                break
+            z = self.lu.solve(r)
+            rz_new = float((r * z).sum())
+            p = z + (rz_new / rz) * p
+            rz = rz_new
+        self.cg_iterations += it + 1
+        # Vertices held outside their plane by the penalty (they would leave the body): let them go next time.
+        leaving = ((x[idx] - q) * n).sum(axis=1) > 0
+        self.released[idx[leaving]] = True
+        return x

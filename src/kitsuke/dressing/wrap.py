@@ -58,6 +58,11 @@ class WrapParams:
     stroke_hold : weight (relative to one triangle edge) pulling the stroke vertices towards their transferred
         positions during the close; 0 lets the garment find its own rest around the strokes (measured on the
         shirt: any hold >= 0.01 raises the mean strain, the strokes ask for more than the pattern can give).
+    contact_weight : weight (relative to one triangle edge) of the body contacts inside the closing solve: each
+        vertex touching the body is held on the plane of its contact (normal direction only, so cloth slides;
+        released where the solve pulls it off). 0 applies collision only after each solve, which fights the
+        solve where it pulls cloth into the body (measured on the kimono: strain 2.5 % mean / 439 % max at 0,
+        1.7 % / 84 % at 20).
     settle_iterations : relaxation iterations with gravity and collision at the end.
     release_strokes : unpin the stroke triangles for the settle (the paper lets the garment settle freely);
         False keeps them where the strokes put them.
@@ -75,6 +80,7 @@ class WrapParams:
     close_iterations: int = 40
     close_tolerance_m: float = 2e-4
     stroke_hold: float = 0.01
+    contact_weight: float = 20.0
     settle_iterations: int = 60
     release_strokes: bool = True
     hold_band_m: tuple[float, float] | None = None
@@ -87,9 +93,16 @@ class WrapParams:
         for name in ("grow_iterations", "close_iterations", "settle_iterations"):
             if getattr(self, name) < 0:
                 raise InputError(f"wrap parameter {name} must be >= 0")
-        if not (self.edge_length_cm > 0 and self.lift_m >= 0 and self.close_tolerance_m >= 0 and self.stroke_hold >= 0):
+        if not (
+            self.edge_length_cm > 0
+            and self.lift_m >= 0
+            and self.close_tolerance_m >= 0
+            and self.stroke_hold >= 0
+            and self.contact_weight >= 0
+        ):
             raise InputError(
-                "wrap parameters edge_length_cm > 0, lift_m >= 0, close_tolerance_m >= 0, stroke_hold >= 0 required"
+                "wrap parameters edge_length_cm > 0, lift_m >= 0, close_tolerance_m >= 0, stroke_hold >= 0, "
+                "contact_weight >= 0 required"
             )
         if self.hold_band_m is not None and not (
             len(self.hold_band_m) == 2 and self.hold_band_m[0] < self.hold_band_m[1]
@@ -260,7 +273,14 @@ def wrap(
     # triangles too; they are only held softly towards where the strokes put them (`stroke_hold`).
     state.pinned = np.zeros(model.n_vertices, dtype=bool)
     if p.close_iterations:
-        solver = GlobalRelax(model, state.pinned, held=seed_pins, targets=state.positions, hold_weight=p.stroke_hold)
+        solver = GlobalRelax(
+            model,
+            state.pinned,
+            held=seed_pins,
+            targets=state.positions,
+            hold_weight=p.stroke_hold,
+            contact_weight=p.contact_weight,
+        )
         for _ in range(p.close_iterations):
             if solver.step(state, collider) < p.close_tolerance_m:
                 break
