@@ -17,12 +17,12 @@ from _timing import timeit
 from kitsuke.body import default_body
 from kitsuke.dressing import PatternStroke, load_packaged_strokes, resolve_strokes, triangles_crossed
 from kitsuke.geometry.surface import Surface
-from kitsuke.pattern import make_kimono, mesh_pattern
+from kitsuke.pattern import default_kimono, mesh_pattern
 
 
 def main() -> None:
     body = default_body()
-    pattern = make_kimono()
+    pattern = default_kimono()
     pm = mesh_pattern(pattern, edge_length=1.5)
     strokes = load_packaged_strokes()
     rng = np.random.default_rng(0)

@@ -1,9 +1,13 @@
 """`kitsuke demo` writes every promised file, and each is a real, readable, non-empty result."""
 
+import json
+
 import numpy as np
+import trimesh
 from PIL import Image
 
 from kitsuke.body import default_body
+from kitsuke.dressing.export import read_garment_obj
 from kitsuke.geometry import load_mesh
 from kitsuke.pattern import load_pattern
 
@@ -24,6 +28,10 @@ def test_demo_writes_real_files(run_cli, tmp_path):
             "body_front.png",
             "body_side.png",
             "kimono_on_stand.png",
+            "dressed.glb",
+            "dressed.obj",
+            "dressed_report.json",
+            "dressed.png",
         ]
     )
     body = load_mesh(out / "body.glb")
@@ -47,6 +55,16 @@ def test_demo_writes_real_files(run_cli, tmp_path):
     assert width(masks["body_front.png"]) > 1.3 * width(masks["body_side.png"])
     # The kimono covers more of the frame than the bare body.
     assert masks["kimono_on_stand.png"].mean() > 1.5 * masks["body_front.png"].mean()
+    # The dressed kimono: read back, on the body, with its quality report.
+    dressed = read_garment_obj(out / "dressed.obj")
+    assert len(dressed.piece_names) == 7 and dressed.positions[:, 1].max() > 1.3
+    report = json.loads((out / "dressed_report.json").read_text())
+    q = report["quality"]
+    assert q["penetration_count"] == 0 and q["seam_gap_mm"] == 0.0 and q["strain_mean"] < 0.025
+    glb = trimesh.load(out / "dressed.glb")
+    assert len(glb.geometry) == 2  # garment and body
+    sheet = np.asarray(Image.open(out / "dressed.png").convert("RGB"))
+    assert sheet.shape[1] > 2 * sheet.shape[0]  # front, side and back side by side
 
 
 def test_demo_bad_size_is_exit_2(run_cli, tmp_path):

@@ -1,4 +1,4 @@
-"""Build src/kitsuke/assets/strokes/kimono_default.json: the kimono (make_kimono()) on default_body().
+"""Build src/kitsuke/assets/strokes/kimono_default.json: the kimono (default_kimono(): cut to the default body) on default_body().
 
 Run from the repository root: python tools/make_kimono_strokes.py [OUT.json]
 
@@ -18,13 +18,13 @@ import numpy as np
 from kitsuke.body import default_body
 from kitsuke.dressing import arc_length, resample_polyline, strokes_from_dict, write_strokes
 from kitsuke.geometry.surface import Surface
-from kitsuke.pattern import make_kimono
+from kitsuke.pattern import default_kimono
 from kitsuke.skeleton import INDEX
 
 body = default_body()
 S = Surface(body.mesh)
 J = body.rig.joints
-pat = make_kimono()
+pat = default_kimono()
 size = pat.meta["kimono"]["size"]
 L, K, W, D, n_neck, k_back = (
     size[k] for k in ("length", "shoulder", "sleeve_width", "sleeve_depth", "neck_width", "back_neck_drop")

@@ -1,7 +1,7 @@
 """The demo behind `kitsuke demo`: the built-in body and kimono, end to end, into one folder.
 
-Until wrapping lands, the kimono is shown at its placement hint around the body (a T-shape, as on a kimono stand);
-the outputs are the files a user would look at first.
+The kimono (`default_kimono()`) is drawn as a pattern, meshed, shown on a stand (its placement hint), then dressed
+on the default body with the packaged strokes, its waist held where the obi goes: the files a user looks at first.
 """
 
 from __future__ import annotations
@@ -24,21 +24,25 @@ def run_demo(out_dir: str | Path = "out", *, size: tuple[int, int] = (800, 1000)
 
     Writes: body.glb; kimono.json / .svg / .png (pattern with edges and seams), kimono_textured.png (flat pattern
     with its asanoha texture); kimono.obj (Triangle mesh, 1.5 cm edges, vt = pattern metres); body_front.png,
-    body_side.png; kimono_on_stand.png (the textured kimono at its placement hint around the body).
+    body_side.png; kimono_on_stand.png (the textured kimono at its placement hint around the body); and the
+    dressed kimono: dressed.glb (textured kimono + body), dressed.obj (SPEC §3.3), dressed_report.json (quality,
+    stroke residuals, timings) and dressed.png (front / side / back).
     size : (width, height) of the renders in pixels.
     """
     from .body import default_body
+    from .dressing.export import garment_glb_mesh, write_garment_glb, write_garment_obj, write_garment_report
+    from .dressing.kimono import dress_default_kimono
     from .geometry import save_mesh
     from .pattern import (
+        default_kimono,
         kimono_texture,
-        make_kimono,
         mesh_pattern,
         mesh_quality,
         save_pattern,
         texture_tile_size_cm,
         write_pattern_obj,
     )
-    from .render import Renderer, write_png
+    from .render import Renderer, render_sheet, write_png
 
     out = Path(out_dir)
     result = DemoResult()
@@ -54,7 +58,7 @@ def run_demo(out_dir: str | Path = "out", *, size: tuple[int, int] = (800, 1000)
     step("body", t)
 
     t = time.perf_counter()
-    kimono = make_kimono()
+    kimono = default_kimono()
     result.files[save_pattern(kimono, out / "kimono.json")] = (
         f"kimono pattern, {len(kimono.pieces)} pieces, {len(kimono.seams)} seams"
     )
@@ -76,12 +80,32 @@ def run_demo(out_dir: str | Path = "out", *, size: tuple[int, int] = (800, 1000)
 
     t = time.perf_counter()
     tile = texture_tile_size_cm("asanoha", 3.0)
-    garment = mesh.to_trimesh(texture=kimono_texture(motif="asanoha", px_per_cm=64), texture_tile_cm=tile)
+    texture = kimono_texture(motif="asanoha", px_per_cm=64)
+    garment = mesh.to_trimesh(texture=texture, texture_tile_cm=tile)
     with Renderer() as r:
         for view in ("front", "side"):
             path = write_png(out / f"body_{view}.png", r.render(body.mesh, view=view, size=size))
             result.files[path] = f"default body, {view} view"
         path = write_png(out / "kimono_on_stand.png", r.render([body.mesh, garment], view="front", size=size))
         result.files[path] = "kimono at its placement hint around the body (before wrapping)"
-    step("render", t)
+        step("render", t)
+
+        t = time.perf_counter()
+        dressed = dress_default_kimono(body)
+        rep = dressed.report
+        step("dress", t)
+        t = time.perf_counter()
+        result.files[
+            write_garment_glb(dressed, out / "dressed.glb", body=body.mesh, texture=texture, tile_m=tile[0] / 100)
+        ] = f"the kimono dressed on the body (strokes + wrap + settle, obi band held), {dressed.n_vertices} vertices"
+        result.files[write_garment_obj(dressed, out / "dressed.obj")] = "dressed kimono, vt = pattern metres"
+        verdict = "all quality targets met" if rep.ok else "targets missed: " + ", ".join(rep.failures())
+        result.files[write_garment_report(dressed, out / "dressed_report.json")] = (
+            f"quality: strain mean {100 * rep.strain_mean:.1f} % max {100 * rep.strain_max:.0f} %, "
+            f"deepest {rep.penetration_deepest_mm:.1f} mm inside, seam gap {rep.seam_gap_mm:.1f} mm; {verdict}"
+        )
+        shown = garment_glb_mesh(dressed, tile_m=tile[0] / 100, texture=texture)
+        sheet = render_sheet([body.mesh, shown], renderer=r, size=(size[0] // 2, size[1] // 2))
+        result.files[write_png(out / "dressed.png", sheet)] = "dressed kimono, front / side / back"
+        step("write", t)
     return result

@@ -17,7 +17,7 @@ from kitsuke.dressing import (
     triangles_crossed,
 )
 from kitsuke.errors import InputError
-from kitsuke.pattern import Curve, Pattern, Piece, mesh_pattern
+from kitsuke.pattern import Curve, Pattern, Piece, default_kimono, mesh_pattern
 
 SRC = "strokes.json"
 
@@ -168,7 +168,9 @@ def test_resolve_checks_the_pattern_first(body_surface, kimono):
 
 
 # -- the packaged strokes ------------------------------------------------------------------------------------
-def test_packaged_kimono_strokes_resolve_on_the_default_body(body, body_surface, kimono, kimono_mesh):
+def test_packaged_kimono_strokes_resolve_on_the_default_body(body, body_surface):
+    kimono = default_kimono()  # the standard kimono cut to the default body
+    kimono_mesh = mesh_pattern(kimono, edge_length=3.0)
     s = load_packaged_strokes("kimono_default")
     assert s.target == "body" and len(s) >= 8 and s.ids == list(range(1, len(s) + 1))
     assert any(p.body.is_laser and p.body.hit == "first" for p in s.pairs)

@@ -108,3 +108,20 @@ def test_cli_defaults_match_the_library():
 
     d = KimonoSize()
     assert KIMONO_DEFAULTS == {k: getattr(d, k) for k in KIMONO_DEFAULTS}
+
+
+def test_fitted_size_cuts_the_length_for_the_body():
+    from kitsuke.pattern import default_kimono, fitted_size
+    from kitsuke.pattern.kimono import UNFOLDED_LENGTH_RATIO
+
+    s = fitted_size(1.666)
+    assert s.length == pytest.approx(UNFOLDED_LENGTH_RATIO * 166.6, abs=0.25) and s.length % 0.5 == 0
+    assert s.yuki == KimonoSize().yuki  # only the length changes
+    assert fitted_size(1.80, KimonoSize(yuki=68.0)).yuki == 68.0
+    for bad in (float("nan"), 0.1, 3.0):
+        with pytest.raises(InputError, match="body height"):
+            fitted_size(bad)
+    k = default_kimono()
+    assert k.meta["kimono"]["size"]["length"] == s.length
+    # The shoulder line sits at 0.84 of the body's height; the hem ends above the floor, near the ankles.
+    assert 0.02 < 0.84 * 1.666 - s.length / 100 < 0.12

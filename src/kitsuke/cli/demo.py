@@ -5,9 +5,12 @@ from __future__ import annotations
 import argparse
 
 EPILOG = """\
-Writes into OUT (default: out/): the default body as GLB, the standard kimono pattern as JSON, SVG and PNG (with
-and without its asanoha texture), the meshed pattern as OBJ, and PNG renders of the body (front, side) and of the
-kimono around it. Open the PNGs first.
+Writes into OUT (default: out/): the default body as GLB, the kimono pattern (the standard size cut to the
+default body) as JSON, SVG and PNG (with and without its asanoha texture), the meshed pattern as OBJ, PNG renders
+of the body (front, side) and of the kimono around it, and the kimono DRESSED on the body with the packaged
+strokes (wrap + settle, waist held where the obi goes): dressed.glb (textured, with the body), dressed.obj
+(vt = pattern metres), dressed_report.json (strain, penetration, seam gap, stroke residuals) and dressed.png
+(front / side / back). Open dressed.png first. Takes about 15 s on 2 cores.
 
 example:
   kitsuke demo --out demo_out
@@ -15,7 +18,7 @@ example:
 
 
 def register(parser: argparse.ArgumentParser) -> None:
-    parser.description = "Run the built-in demo: default body + standard kimono -> files in a folder."
+    parser.description = "Run the built-in demo: dress the default body in the kimono -> files in a folder."
     parser.epilog = EPILOG
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.add_argument("--out", default="out", metavar="DIR", help="output folder (default: out)")

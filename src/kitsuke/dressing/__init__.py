@@ -55,7 +55,7 @@ def packaged_strokes_path(name: str = "kimono_default") -> Path:
 
 
 def load_packaged_strokes(name: str = "kimono_default") -> Strokes:
-    """Read a packaged strokes file: "kimono_default" is the kimono (`make_kimono()`) on `default_body()`."""
+    """Read a packaged strokes file: "kimono_default" is the kimono (`default_kimono()`) on `default_body()`."""
     return read_strokes(packaged_strokes_path(name))
 
 

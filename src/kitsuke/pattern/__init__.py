@@ -7,7 +7,8 @@ from the outer face, optional `Curve` per edge, optional `Placement` hint) and `
 - `load_pattern(path)`: kitsuke JSON, GarmentCode JSON (told apart by content) or SVG, fully validated.
 - `save_pattern(pattern, path)`: .json (kitsuke v1), .svg or .png (annotated picture; optional texture).
 - `validate(pattern) -> list[Issue]`: errors and warnings (e.g. seam length mismatch above 1 %).
-- `make_kimono(KimonoSize(...))`: the parametric kimono; `kimono_texture(...)`: asanoha / seigaiha.
+- `make_kimono(KimonoSize(...))`: the parametric kimono; `default_kimono()`: the one the demo dresses (cut to the
+  default body, `fitted_size`); `kimono_texture(...)`: asanoha / seigaiha.
 - `mesh_pattern(pattern, edge_length=1.5)` -> `PatternMesh` (seam-matched Triangle meshes), `write_pattern_obj`.
 """
 
@@ -19,7 +20,7 @@ from ._mesh import PatternMesh, mesh_pattern, mesh_quality, obj_text, write_patt
 from ._svg_import import read_svg
 from ._types import Curve, CurveType, EdgeRef, Fold, Pattern, Piece, Placement, Seam
 from ._validate import Issue, check_pattern, validate
-from .kimono import KimonoSize, make_kimono
+from .kimono import KimonoSize, default_kimono, fitted_size, make_kimono
 from .texture import MOTIFS, PALETTES, kimono_texture, texture_tile_size_cm, texture_uv
 
 __all__ = [
@@ -43,6 +44,8 @@ __all__ = [
     "load_pattern",
     "load_pattern_with_issues",
     "make_kimono",
+    "default_kimono",
+    "fitted_size",
     "mesh_pattern",
     "mesh_quality",
     "obj_text",

@@ -41,7 +41,7 @@ neckline). The wearer's right is -X.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 
@@ -172,6 +172,32 @@ class KimonoSize:
     def label(self) -> str:
         """Short description, e.g. 'kimono 158/63/31/49' (length/yuki/shoulder/sleeve depth)."""
         return f"kimono {self.length:g}/{self.yuki:g}/{self.shoulder:g}/{self.sleeve_depth:g}"
+
+
+#: Length (身丈) of a kimono worn without an ohashori fold, as a fraction of the wearer's height: from the shoulder
+#: line (0.84 h) over the chest to just above the ankles. A standard kimono is longer (158 cm for 1.60-1.70 m) and
+#: the excess is folded up under the obi (ohashori), a fold the wrap does not make: dressed as it is, its hem
+#: would pile on the floor.
+UNFOLDED_LENGTH_RATIO = 0.815
+
+
+def fitted_size(body_height_m: float, size: KimonoSize | None = None) -> KimonoSize:
+    """`size` (default: the standard size) with its length cut for `body_height_m` (metres) worn without an
+    ohashori fold (UNFOLDED_LENGTH_RATIO), rounded to 0.5 cm."""
+    if not (math.isfinite(body_height_m) and 0.5 <= body_height_m <= 2.5):
+        raise InputError(f"body height {body_height_m!r} m is outside 0.5..2.5 m")
+    base = size or KimonoSize()
+    return replace(base, length=round(2 * UNFOLDED_LENGTH_RATIO * body_height_m * 100) / 2)
+
+
+def default_kimono() -> Pattern:
+    """The kimono that `kitsuke demo` dresses and the packaged strokes `kimono_default` place: the standard size
+    cut to the default body's height (1.666 m), worn without an ohashori fold (`fitted_size`)."""
+    return make_kimono(fitted_size(DEFAULT_BODY_HEIGHT_M), body_height_m=DEFAULT_BODY_HEIGHT_M)
+
+
+#: Height of `kitsuke.body.default_body()`, metres (checked by its tests).
+DEFAULT_BODY_HEIGHT_M = 1.666
 
 
 def _opt(name: str) -> str:
