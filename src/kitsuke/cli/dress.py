@@ -18,9 +18,16 @@ vt = pattern metres, seam vertices shared, one `# kitsuke piece` line per piece)
 penetration, strain, seam gap, inverted triangles, stroke residuals, timings); --png a front/side/back picture.
 The command exits 0 when the garment is written, whether or not every quality target is met: read the report.
 
+Re-wrap: give --garment (a dressed OBJ written by --obj) instead of --pattern, and a strokes file with
+"target": "garment" (its pattern strokes on the garment's pieces, cm; its 3D strokes drawn on the garment where
+that part should go). The stroke triangles are laid along the new strokes, the rest follows, attenuated towards
+the pins (--pin X,Y,Z, metres, snapped to the nearest garment vertex, repeatable), which do not move at all.
+
 examples:
   kitsuke dress --body mean_all.obj --pattern shirt_mean_specification.json \\
                 --strokes shirt_mean_all.json -o shirt.glb --obj shirt.obj --report shirt.json --png shirt.png
+  kitsuke dress --body default --garment dressed.obj --strokes lift_sleeve.json \\
+                --pin 0,1.0,0.15 --pin 0,1.0,-0.15 -o rewrapped.glb --obj rewrapped.obj
 """
 
 
@@ -29,12 +36,22 @@ def register(parser: argparse.ArgumentParser) -> None:
     parser.epilog = EPILOG
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.add_argument("--body", required=True, metavar="BODY", help="body mesh file or `default`")
-    parser.add_argument("--pattern", required=True, metavar="PATTERN", help="pattern: kitsuke/GarmentCode JSON, SVG")
+    what = parser.add_mutually_exclusive_group(required=True)
+    what.add_argument("--pattern", metavar="PATTERN", help="pattern to dress: kitsuke/GarmentCode JSON, SVG")
+    what.add_argument("--garment", metavar="DRESSED.obj", help="re-wrap this dressed garment (OBJ from --obj)")
     parser.add_argument("--strokes", required=True, metavar="STROKES", help="kitsuke strokes JSON")
     parser.add_argument("-o", "--output", required=True, metavar="OUT.glb", help="GLB output (garment + body)")
     parser.add_argument("--obj", metavar="OUT.obj", help="also write the SPEC 3.3 OBJ (vt = pattern metres)")
     parser.add_argument("--report", metavar="REPORT.json", help="also write the quality report")
     parser.add_argument("--png", metavar="VIEWS.png", help="also write a front/side/back picture")
+    parser.add_argument(
+        "--pin",
+        action="append",
+        default=[],
+        metavar="X,Y,Z",
+        help="re-wrap only: hold the garment vertex nearest this point (metres; repeatable; write "
+        "--pin=-0.1,1.0,0.15 when X is negative)",
+    )
     parser.add_argument(
         "--edge-length",
         type=float,
@@ -53,7 +70,7 @@ def run(args: argparse.Namespace) -> int:
     from ..errors import InputError
     from ..pattern import load_pattern
 
-    inputs = [args.body, args.pattern, args.strokes]
+    inputs = [args.body, args.pattern or args.garment, args.strokes]
     outs = [checked_output(args.output, inputs, suffixes=(".glb",))]
     for extra, suffix in ((args.obj, ".obj"), (args.report, ".json"), (args.png, ".png")):
         if extra:
@@ -62,6 +79,10 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("the output files must be different")
     if not 0.2 <= args.edge_length <= 10:
         raise InputError(f"--edge-length must be between 0.2 and 10 cm, got {args.edge_length}")
+    if args.garment:
+        return _rewrap(args, outs)
+    if args.pin:
+        raise InputError("--pin holds part of a dressed garment: use it with --garment (a re-wrap)")
     # Cheap checks first: a bad pattern or strokes file fails before the body is loaded.
     pattern = load_pattern(args.pattern)
     strokes = read_strokes(args.strokes)
@@ -79,6 +100,49 @@ def run(args: argparse.Namespace) -> int:
     verdict = "" if r is None else ("all quality targets met" if r.ok else "targets missed: " + ", ".join(r.failures()))
     print(
         f"wrote {args.output}: {garment.n_vertices} vertices, wrap {garment.timings.get('wrap', 0.0):.2f} s; {verdict}",
+        file=sys.stderr,
+    )
+    return 0
+
+
+def _pin_points(values: list[str]) -> list[list[float]]:
+    from ..errors import InputError
+
+    pins = []
+    for v in values:
+        try:
+            xyz = [float(c) for c in v.split(",")]
+        except ValueError:
+            xyz = []
+        if len(xyz) != 3:
+            raise InputError(f"--pin must be X,Y,Z in metres, got {v!r}")
+        pins.append(xyz)
+    return pins
+
+
+def _rewrap(args: argparse.Namespace, outs: list) -> int:
+    from .._files import write_json_atomic
+    from ..dressing import read_strokes
+    from ..dressing.export import read_garment_obj, write_garment_glb, write_garment_obj, write_garment_png
+    from ..dressing.rewrap import rewrap
+
+    pins = _pin_points(args.pin)
+    garment = read_garment_obj(args.garment)
+    strokes = read_strokes(args.strokes)
+    body = body_from_args(args)
+    result = rewrap(body, garment, strokes, pins=pins)
+    write_garment_glb(result.garment, outs[0], body=body.mesh)
+    if args.obj:
+        write_garment_obj(result.garment, args.obj)
+    if args.report:
+        write_json_atomic(args.report, result.summary())
+    if args.png:
+        write_garment_png(result.garment, body.mesh, args.png)
+    r = result.report
+    verdict = "all quality targets met" if r.ok else "targets missed: " + ", ".join(r.failures())
+    print(
+        f"wrote {args.output}: re-wrapped {len(result.stroke_ids)} stroke(s), moved up to "
+        f"{result.moved_m.max() * 100:.1f} cm, {int(result.pinned.sum())} pinned vertices still; {verdict}",
         file=sys.stderr,
     )
     return 0

@@ -110,7 +110,12 @@ def _extended_coordinates(points_cm: np.ndarray, stroke_cm: np.ndarray) -> tuple
 
 def _locate(pm: PatternMesh, faces: np.ndarray, points_cm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The face among `faces` holding each 2D point (the best one if on none) and its barycentric coordinates."""
-    tri = pm.vertices_cm[pm.faces[faces]]  # (m, 3, 2)
+    return locate_in_triangles(pm.vertices_cm[pm.faces[faces]], faces, points_cm)
+
+
+def locate_in_triangles(tri: np.ndarray, faces: np.ndarray, points_cm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The face among `faces` (m,) with 2D triangles `tri` (m, 3, 2) holding each point (n, 2) (the best one if on
+    none) and its barycentric coordinates (n, 3)."""
     a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
     v0, v1 = b - a, c - a
     den = v0[:, 0] * v1[:, 1] - v0[:, 1] * v1[:, 0]
@@ -154,34 +159,11 @@ def place_strokes(
         d1, d2 = t0[1] - t0[0], t0[2] - t0[0]
         side = 1.0 if d1[0] * d2[1] - d1[1] * d2[0] > 0 else -1.0
 
-        body_pts = pair.body.surface_points
-        rough = arc_length(body_pts)[-1]
-        n_path = int(np.clip(np.ceil(rough / PATH_STEP_M) + 1, 2, 2000))
-        bpath = resample_on_surface(surface, body_pts, n_path).points
-        lb = float(arc_length(bpath)[-1])
+        bpath, lb = body_path(surface, pair, path)
         lp = ps.length_cm
-        if lb < 1e-3:
-            raise InputError(f"stroke {pair.id}: body stroke has zero length on the surface", path)
 
         vids = np.unique(pm.faces[crossed])
-        s, off = _extended_coordinates(pm.vertices_cm[vids], np.asarray(ps.points, dtype=np.float64))
-        t = s / lp
-        inside = np.clip(t, 0.0, 1.0) * lb
-        q = interpolate_polyline(bpath, inside)
-        eps = min(0.01, 0.25 * lb)
-        tangent = interpolate_polyline(bpath, inside + eps) - interpolate_polyline(bpath, inside - eps)
-        on = surface.closest(q)
-        normal = smooth_normals(collider, on.faces, on.barycentric)
-        tangent -= np.einsum("ij,ij->i", tangent, normal)[:, None] * normal
-        tangent /= np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-300)
-        across = side * np.cross(normal, tangent)
-        # Beyond its ends the stroke is continued straight along its end tangent (metres of body per metre of
-        # pattern: lb / lp), so the crossed triangles that stick out past an end keep their shape.
-        beyond = (t - np.clip(t, 0.0, 1.0)) * lb
-        x = on.points + beyond[:, None] * tangent + (off / 100.0)[:, None] * across
-        proj = surface.closest(x)
-        nx = smooth_normals(collider, proj.faces, proj.barycentric)
-        x = proj.points + lift_m * nx
+        x = lay_along(pm.vertices_cm[vids], ps, side, bpath, surface, collider, lift_m=lift_m)
         g = welded.vertex_of[vids]
         np.add.at(acc, g, x)
         np.add.at(cnt, g, 1.0)
@@ -194,3 +176,50 @@ def place_strokes(
     pos = np.zeros((nv, 3))
     pos[placed] = acc[placed] / cnt[placed, None]
     return Placement(pos, placed, seed[welded.face_order], tracks)
+
+
+def body_path(surface: Surface, pair, path: str | None) -> tuple[np.ndarray, float]:
+    """The body stroke of `pair` traced on `surface` ((k, 3) metres, every PATH_STEP_M) and its length."""
+    body_pts = pair.body.surface_points
+    rough = arc_length(body_pts)[-1]
+    n_path = int(np.clip(np.ceil(rough / PATH_STEP_M) + 1, 2, 2000))
+    bpath = resample_on_surface(surface, body_pts, n_path).points
+    lb = float(arc_length(bpath)[-1])
+    if lb < 1e-3:
+        raise InputError(f"stroke {pair.id}: body stroke has zero length on the surface", path)
+    return bpath, lb
+
+
+def lay_along(
+    points_cm: np.ndarray,
+    ps,
+    side: float,
+    bpath: np.ndarray,
+    surface: Surface,
+    collider: BodyCollider,
+    *,
+    lift_m: float,
+) -> np.ndarray:
+    """Positions (n, 3) metres on the body of pattern points (n, 2) cm near the pattern stroke `ps`: arc length
+    along the stroke mapped onto the body path `bpath` (k, 3), the offset across it laid out on the surface
+    (`side` = the piece's orientation sign), `lift_m` off the surface."""
+    lb = float(arc_length(bpath)[-1])
+    lp = ps.length_cm
+    s, off = _extended_coordinates(points_cm, np.asarray(ps.points, dtype=np.float64))
+    t = s / lp
+    inside = np.clip(t, 0.0, 1.0) * lb
+    q = interpolate_polyline(bpath, inside)
+    eps = min(0.01, 0.25 * lb)
+    tangent = interpolate_polyline(bpath, inside + eps) - interpolate_polyline(bpath, inside - eps)
+    on = surface.closest(q)
+    normal = smooth_normals(collider, on.faces, on.barycentric)
+    tangent -= np.einsum("ij,ij->i", tangent, normal)[:, None] * normal
+    tangent /= np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-300)
+    across = side * np.cross(normal, tangent)
+    # Beyond its ends the stroke is continued straight along its end tangent (metres of body per metre of
+    # pattern: lb / lp), so the crossed triangles that stick out past an end keep their shape.
+    beyond = (t - np.clip(t, 0.0, 1.0)) * lb
+    x = on.points + beyond[:, None] * tangent + (off / 100.0)[:, None] * across
+    proj = surface.closest(x)
+    nx = smooth_normals(collider, proj.faces, proj.barycentric)
+    return proj.points + lift_m * nx

@@ -22,6 +22,7 @@ from ..geometry import TriMesh, save_mesh
 from .wrap import DressedGarment
 
 PIECE_TAG = "kitsuke piece"
+NAME_TAG = "kitsuke dressed garment"
 
 
 @dataclass
@@ -30,6 +31,8 @@ class GarmentFile:
 
     positions : (V, 3) float64 m. faces : (F, 3) int64. corner_uv : (F, 3, 2) float64, pattern metres.
     piece_names : (P,) names. piece_faces : (P, 2) int64 [start, stop) face ranges.
+    name : the garment's name (from the file's `# kitsuke dressed garment <name>` line; "garment" without one).
+    The writers below take a GarmentFile as well as a DressedGarment (a dragged garment is written this way).
     """
 
     positions: np.ndarray
@@ -37,6 +40,7 @@ class GarmentFile:
     corner_uv: np.ndarray
     piece_names: list[str]
     piece_faces: np.ndarray
+    name: str = "garment"
 
     @property
     def rest_edge_lengths(self) -> np.ndarray:
@@ -45,10 +49,10 @@ class GarmentFile:
         return np.linalg.norm(uv[:, [1, 2, 0]] - uv, axis=2)
 
 
-def garment_obj_text(garment: DressedGarment) -> str:
+def garment_obj_text(garment: DressedGarment | GarmentFile) -> str:
     """The SPEC §3.3 OBJ of a dressed garment, as text."""
     out = io.StringIO()
-    out.write(f"# kitsuke dressed garment {garment.name}\n# v: world metres (Y up); vt: pattern metres, piece-local\n")
+    out.write(f"# {NAME_TAG} {garment.name}\n# v: world metres (Y up); vt: pattern metres, piece-local\n")
     for name, (a, b) in zip(garment.piece_names, garment.piece_faces, strict=True):
         out.write(f"# {PIECE_TAG} {name} {int(a)} {int(b) - 1}\n")
     np.savetxt(out, garment.positions, fmt="v %.7f %.7f %.7f")
@@ -59,7 +63,7 @@ def garment_obj_text(garment: DressedGarment) -> str:
     return out.getvalue()
 
 
-def write_garment_obj(garment: DressedGarment, path: str | os.PathLike[str]) -> Path:
+def write_garment_obj(garment: DressedGarment | GarmentFile, path: str | os.PathLike[str]) -> Path:
     """Write the SPEC §3.3 OBJ atomically."""
     return write_text_atomic(path, garment_obj_text(garment))
 
@@ -76,9 +80,11 @@ def read_garment_obj(path: str | os.PathLike[str]) -> GarmentFile:
         raise InputError("not a dressed garment: every face corner needs a vt (its pattern position)", path)
     if not (np.isfinite(data.vertices).all() and np.isfinite(data.uv).all()):
         raise InputError("holds NaN or infinite coordinates", path)
-    names, ranges = [], []
+    names, ranges, garment_name = [], [], "garment"
     for line in data.comments:
-        if line.startswith(PIECE_TAG + " "):
+        if line.startswith(NAME_TAG + " ") and line[len(NAME_TAG) + 1 :].strip():
+            garment_name = line[len(NAME_TAG) + 1 :].strip()
+        elif line.startswith(PIECE_TAG + " "):
             try:
                 name, first, last = line[len(PIECE_TAG) + 1 :].rsplit(" ", 2)
                 names.append(name)
@@ -90,10 +96,12 @@ def read_garment_obj(path: str | os.PathLike[str]) -> GarmentFile:
     piece_faces = np.array(ranges, dtype=np.int64)
     if piece_faces.min() < 0 or piece_faces.max() > len(data.faces):
         raise InputError("a piece line names faces the file does not have", path)
-    return GarmentFile(data.vertices, data.faces, data.uv[data.face_uv], names, piece_faces)
+    return GarmentFile(data.vertices, data.faces, data.uv[data.face_uv], names, piece_faces, garment_name)
 
 
-def garment_glb_mesh(garment: DressedGarment, *, tile_m: float = 1.0, texture: np.ndarray | None = None) -> TriMesh:
+def garment_glb_mesh(
+    garment: DressedGarment | GarmentFile, *, tile_m: float = 1.0, texture: np.ndarray | None = None
+) -> TriMesh:
     """The garment as a TriMesh for viewers: vertices split where corners disagree on uv; uv = pattern / tile_m."""
     corner_v = garment.faces.reshape(-1)
     corner_uv = garment.corner_uv.reshape(-1, 2)
@@ -104,7 +112,7 @@ def garment_glb_mesh(garment: DressedGarment, *, tile_m: float = 1.0, texture: n
 
 
 def write_garment_glb(
-    garment: DressedGarment,
+    garment: DressedGarment | GarmentFile,
     path: str | os.PathLike[str],
     *,
     body: TriMesh | None = None,
@@ -124,10 +132,30 @@ def write_garment_report(garment: DressedGarment, path: str | os.PathLike[str]) 
 
 
 def write_garment_png(
-    garment: DressedGarment, body: TriMesh, path: str | os.PathLike[str], *, size: tuple[int, int] = (500, 640)
+    garment: DressedGarment | GarmentFile,
+    body: TriMesh,
+    path: str | os.PathLike[str],
+    *,
+    size: tuple[int, int] = (500, 640),
 ) -> Path:
     """Write a labelled front / side / back sheet of the garment on the body."""
     from ..render import render_sheet, write_png
 
     mesh = garment_glb_mesh(garment)
     return write_png(path, render_sheet([body, TriMesh(mesh.vertices, mesh.faces, name=garment.name)], size=size))
+
+
+def as_garment_file(garment: DressedGarment | GarmentFile) -> GarmentFile:
+    """A DressedGarment as the GarmentFile its OBJ would read back as (positions copied); a GarmentFile as is."""
+    if isinstance(garment, GarmentFile):
+        return garment
+    if isinstance(garment, DressedGarment):
+        return GarmentFile(
+            np.array(garment.positions, dtype=np.float64),
+            garment.faces,
+            garment.corner_uv,
+            list(garment.piece_names),
+            garment.piece_faces,
+            garment.name,
+        )
+    raise InputError("garment must be a DressedGarment or a GarmentFile (read_garment_obj)")

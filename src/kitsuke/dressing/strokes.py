@@ -450,6 +450,13 @@ def resolve_strokes(
     have `surface` filled in; raises InputError naming the strokes file and the stroke id.
     """
     check_strokes(strokes, pattern, pattern_mesh=pattern_mesh)
+    return strokes_on_surface(strokes, surface, max_distance_m=max_distance_m)
+
+
+def strokes_on_surface(
+    strokes: Strokes, surface: TriMesh | Surface, *, max_distance_m: float = MAX_SURFACE_DISTANCE_M
+) -> Strokes:
+    """The 3D side of `resolve_strokes` alone (no pattern check): every body stroke put on `surface`."""
     if not (math.isfinite(max_distance_m) and max_distance_m > 0):
         raise ValueError("max_distance_m must be a positive number of metres")
     surf = Surface.of(surface)
