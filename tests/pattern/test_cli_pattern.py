@@ -96,3 +96,14 @@ def test_subprocess_run(tmp_path):
         timeout=120,
     )
     assert r.returncode == 2 and r.stderr.strip().endswith("pattern file not found") and "missing.json" in r.stderr
+
+
+def test_kimono_fit_height_gives_the_default_kimono(run_cli, tmp_path):
+    from kitsuke.pattern import default_kimono, load_pattern
+
+    r = run_cli("pattern", "kimono", "--fit-height", "1.666", "-o", tmp_path / "k.json")
+    assert r.code == 0, r.err
+    got = load_pattern(tmp_path / "k.json")
+    assert got.meta["kimono"]["size"] == default_kimono().meta["kimono"]["size"]
+    bad = run_cli("pattern", "kimono", "--fit-height", "0.2", "-o", tmp_path / "k2.json")
+    assert bad.code == 2 and "--fit-height" in bad.err and not (tmp_path / "k2.json").exists()

@@ -115,9 +115,18 @@ def register(parser: argparse.ArgumentParser) -> None:
         "Output by extension: .json (the pattern), .svg or .png (its picture).\n\nexamples:\n"
         "  kitsuke pattern kimono -o kimono.json\n"
         "  kitsuke pattern kimono --length 150 --yuki 66 --shoulder 32 -o kimono.json\n"
-        "  kitsuke pattern kimono --sleeve-depth 110 -o furisode.png --texture asanoha\n",
+        "  kitsuke pattern kimono --sleeve-depth 110 -o furisode.png --texture asanoha\n"
+        "  kitsuke pattern kimono --fit-height 1.666 -o kimono.json   # the demo's kimono (packaged strokes fit it)\n",
     )
     _size_arguments(p)
+    p.add_argument(
+        "--fit-height",
+        type=float,
+        metavar="M",
+        default=None,
+        help="cut the length for a wearer this tall (metres), worn without an ohashori fold (replaces --length); "
+        "1.666 gives the default body's kimono, the one the packaged strokes `kimono_default` place",
+    )
     p.add_argument("-o", "--output", required=True, metavar="OUT", help="output file (.json, .svg or .png)")
     _picture_options(p)
     p.set_defaults(run=run_kimono)
@@ -280,7 +289,7 @@ def run_validate(args: argparse.Namespace) -> int:
 
 
 def run_kimono(args: argparse.Namespace) -> int:
-    from ..pattern import KimonoSize, make_kimono, save_pattern
+    from ..pattern import KimonoSize, fitted_size, make_kimono, save_pattern
 
     out = checked_output(args.output, [], suffixes=(".json", ".svg", ".png"))
     size = KimonoSize(
@@ -291,6 +300,8 @@ def run_kimono(args: argparse.Namespace) -> int:
         sleeve_depth=args.sleeve_depth,
         bolt_width=args.bolt_width,
     )
+    if args.fit_height is not None:
+        size = fitted_size(args.fit_height, size)
     pattern = make_kimono(size)
     save_pattern(pattern, out, **_picture_kwargs(args, out.suffix.lower()))
     print(f"{out}: {pattern.meta['kimono']['label']}: {len(pattern.pieces)} pieces, {len(pattern.seams)} seams")

@@ -185,7 +185,7 @@ def fitted_size(body_height_m: float, size: KimonoSize | None = None) -> KimonoS
     """`size` (default: the standard size) with its length cut for `body_height_m` (metres) worn without an
     ohashori fold (UNFOLDED_LENGTH_RATIO), rounded to 0.5 cm."""
     if not (math.isfinite(body_height_m) and 0.5 <= body_height_m <= 2.5):
-        raise InputError(f"body height {body_height_m!r} m is outside 0.5..2.5 m")
+        raise InputError(f"body height {body_height_m!r} m is outside 0.5..2.5 m", "--fit-height")
     base = size or KimonoSize()
     return replace(base, length=round(2 * UNFOLDED_LENGTH_RATIO * body_height_m * 100) / 2)
 
