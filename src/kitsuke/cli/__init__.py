@@ -21,7 +21,8 @@ GROUPS: dict[str, tuple[str, str]] = {
     "demo": ("demo", "write the default body, kimono pattern and renders to out/"),
     "body": ("body", "inspect and convert body meshes"),
     "pattern": ("pattern", "convert, validate, mesh and generate sewing patterns"),
-    "dress": ("dress", "put a garment on a body from a pattern and stroke pairs (wrap + settle)"),
+    "dress": ("dress", "put a garment on a body from a pattern and stroke pairs (wrap + settle), or re-wrap it"),
+    "drag": ("drag", "drag a dressed garment along the body, with pins (replays a drags file)"),
     "render": ("render", "render meshes to PNG"),
     "pose": ("pose", "extract poses from video/images/camera/BVH and correct them for a kimono"),
 }

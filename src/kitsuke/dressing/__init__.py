@@ -1,7 +1,13 @@
 """Sketch-based dressing (SPEC §4): corresponding strokes on the pattern and the body, and the wrap.
 
 - `wrap(body, pattern_or_mesh, strokes)` -> `DressedGarment`: strokes' triangles placed on the body, the rest grown
-  from the placed cloth, seams shut, a gravity settle; with a quality report (work in progress: see its docstring).
+  from the placed cloth, seams shut, a gravity settle; with a quality report.
+
+- `rewrap(body, dressed, strokes, pins=...)` (`kitsuke.dressing.rewrap`): strokes with "target": "garment" move
+  part of a dressed garment; pins hold the rest.
+- `DragSession(body, dressed)`: grab / move_to / move_by / release / pin / unpin, the garment following along the
+  body surface; `read_drags` / `apply_drags`: replay a kitsuke drags v1 file (SPEC §3.5).
+- `dress_default_kimono()` (`kitsuke.dressing.kimono`): the demo's kimono on the default body, obi band held.
 
 - `read_strokes(path)` / `write_strokes(strokes, path)`: kitsuke strokes v1 JSON (SPEC §3.2).
 - `check_strokes(strokes, pattern, pattern_mesh=...)`: the pattern side (pieces, points on them, triangles
@@ -26,6 +32,18 @@ from ._polyline import (
     stroke_coordinates,
     surface_length,
     surface_polyline,
+)
+from .drag import DragParams, DragSession, Grab, MoveStats
+from .drags import (
+    Drags,
+    DragStep,
+    StepResult,
+    apply_drags,
+    drags_from_dict,
+    drags_to_dict,
+    drags_to_json,
+    read_drags,
+    write_drags,
 )
 from .strokes import (
     FORMAT,
@@ -60,6 +78,19 @@ def load_packaged_strokes(name: str = "kimono_default") -> Strokes:
 
 
 __all__ = [
+    "DragParams",
+    "DragSession",
+    "DragStep",
+    "Drags",
+    "Grab",
+    "MoveStats",
+    "StepResult",
+    "apply_drags",
+    "drags_from_dict",
+    "drags_to_dict",
+    "drags_to_json",
+    "read_drags",
+    "write_drags",
     "DressedGarment",
     "WrapParams",
     "wrap",

@@ -31,6 +31,7 @@ from ..geometry import TriMesh
 from ..geometry.surface import Surface
 from ..metrics import QualityReport, quality_report
 from ._crossing import segments_cross_triangles
+from ._drag_field import follow_weights
 from ._place import RESIDUAL_SAMPLES, body_path, lay_along, locate_in_triangles, polyline_distance
 from ._polyline import resample_polyline
 from ._solve import GlobalRelax
@@ -132,25 +133,6 @@ def snap_pins(garment: GarmentFile, points, *, source: str | None = None) -> np.
     return mask
 
 
-def _follow_weights(model: ClothModel, sources: np.ndarray, pinned: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """For each vertex: the nearest stroke vertex over the cloth (shortest path along edges) and the weight of
-    its displacement, 1 at the strokes falling smoothly (smoothstep, no kink) to 0 at the pins."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import dijkstra
-
-    e, n = model.edges, model.n_vertices
-    graph = coo_matrix((model.rest_lengths, (e[:, 0], e[:, 1])), shape=(n, n)).tocsr()
-    src = np.flatnonzero(sources)
-    d_s, _, nearest = dijkstra(graph, directed=False, indices=src, min_only=True, return_predecessors=True)
-    if not pinned.any():
-        return nearest, np.where(np.isfinite(d_s), 1.0, 0.0)
-    d_p = dijkstra(graph, directed=False, indices=np.flatnonzero(pinned), min_only=True)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        r = np.where(np.isfinite(d_p), d_p / (d_s + d_p), 1.0)
-    r = np.where(np.isfinite(d_s), np.nan_to_num(r, nan=0.0), 0.0)
-    return nearest, r * r * (3.0 - 2.0 * r)
-
-
 def rewrap(
     body,
     garment,
@@ -226,7 +208,7 @@ def rewrap(
     target[on_stroke] = acc[on_stroke] / cnt[on_stroke, None]
 
     # 2. The rest follows its nearest stroke vertex, attenuated towards the pins.
-    nearest, weight = _follow_weights(model, on_stroke, pinned)
+    weight, nearest = follow_weights(model, on_stroke, pinned)
     shift = target - g.positions
     reach = nearest >= 0
     move = np.zeros_like(g.positions)

@@ -1,0 +1,77 @@
+"""Benchmark: dragging the default kimono (~5k vertices) along the default body (issue 4: one update <= 33 ms).
+
+    /work/venv/bin/python benchmarks/bench_drag.py [--edge-length 2.5] [--updates 60]
+
+One update = one mouse-move event: the drag spread over the garment (the body part's rigid motion, the feet
+sliding along the body) plus the relaxation (one global step, two local iterations, collision). Printed: the
+garment size, the time to open a session, grab (dependency graph, weights, factorisation), one update for
+mouse-sized moves (2 mm) and drags-file-sized moves (1 cm), and the release; medians and minima over the updates
+(the minimum is the figure least disturbed by other work on a shared machine).
+
+On a 2-core machine with another process busy on one core, OpenMP threads that spin while they wait (numba's
+"omp" layer; libgomp's default) make every update take ~190 ms instead of ~10; OMP_WAIT_POLICY=PASSIVE avoids it
+(measured 14 ms under the same load). KITSUKE_NUMBA_PARALLEL=0 runs kitsuke's kernels single-threaded.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+import numpy as np
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--edge-length", type=float, default=2.5, help="kimono triangle edge length, cm (default 2.5)")
+    ap.add_argument("--updates", type=int, default=60, help="updates timed per move size (default 60)")
+    args = ap.parse_args()
+    from kitsuke.body import default_body
+    from kitsuke.cloth import BodyCollider
+    from kitsuke.dressing import WrapParams
+    from kitsuke.dressing.drag import DragSession
+    from kitsuke.dressing.kimono import dress_default_kimono
+
+    body = default_body()
+    collider = BodyCollider.from_body(body)
+    garment = dress_default_kimono(body, params=WrapParams(edge_length_cm=args.edge_length))
+    print(
+        f"kimono {garment.n_vertices} vertices, {len(garment.faces)} faces; numba threads: "
+        f"{'off' if os.environ.get('KITSUKE_NUMBA_PARALLEL') == '0' else 'on'} ({os.cpu_count()} cores), "
+        f"OMP_WAIT_POLICY={os.environ.get('OMP_WAIT_POLICY', '(default)')}"
+    )
+    DragSession(body, garment, collider=collider).grab(vertex=0)  # warm-up: numba compilation, caches
+    t = time.perf_counter()
+    session = DragSession(body, garment, collider=collider)
+    t_open = time.perf_counter() - t
+    x = session.positions
+    front = int(np.argmax(x[:, 2] - 5 * np.abs(x[:, 0]) - 5 * np.abs(x[:, 1] - 1.1)))
+    t = time.perf_counter()
+    session.grab(vertex=front)
+    t_grab = time.perf_counter() - t
+    print(f"open session {1e3 * t_open:.0f} ms, grab {1e3 * t_grab:.0f} ms")
+    for step_m in (0.002, 0.01):
+        times = []
+        for k in range(args.updates):
+            up = 1.0 if (k // 10) % 2 == 0 else -1.0  # up and down, so the garment stays on the body
+            t = time.perf_counter()
+            session.update(np.array([0.0, up * step_m, 0.0]))
+            times.append(time.perf_counter() - t)
+        times_ms = 1e3 * np.array(times)
+        print(
+            f"update, {1e3 * step_m:.0f} mm moves: median {np.median(times_ms):.1f} ms, min {times_ms.min():.1f} ms, "
+            f"90th percentile {np.percentile(times_ms, 90):.1f} ms ({1e3 / np.median(times_ms):.0f} updates/s)"
+        )
+    t = time.perf_counter()
+    session.release()
+    print(f"release {1e3 * (time.perf_counter() - t):.0f} ms")
+    r = session.report()
+    print(
+        f"quality after {2 * args.updates} updates: penetration {r.penetration_count}, strain mean "
+        f"{100 * r.strain_mean:.2f} % max {100 * r.strain_max:.0f} %, inverted {r.inverted_count}"
+    )
+
+
+if __name__ == "__main__":
+    main()
