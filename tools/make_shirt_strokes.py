@@ -1,143 +1,115 @@
-"""Generate src/kitsuke/assets/strokes/shirt_mean_all.json: GarmentCode's shirt on mean_all (laser strokes from the front,
-length-matched on the surface).
+"""Generate src/kitsuke/assets/strokes/shirt_mean_all.json: GarmentCode's shirt on mean_all, hung from the shoulders.
 
-Run from the repository root: python tools/make_shirt_strokes.py src/kitsuke/assets/strokes/shirt_mean_all.json
+Run from the repository root: python tools/make_shirt_strokes.py [OUT.json]
+
+Strokes (drawn points on the body; each pattern stroke as long as its body stroke), right side first:
+  torso panels (4): a vertical line through the middle of the shoulder seam (|u| = 15 cm), from 1.5 cm below
+      the seam down the front (back) of the body in the plane |x| = 0.15 m, from 1.5 cm past the shoulder ridge
+      to where the chest (shoulder blade) stands out most, not below 1.2 m;
+  sleeve panels (4): a line 2.5 cm below the sleeve's top seam, from 1.5 cm off the armhole to 1.5 cm short of
+      the cuff, on the body 2.5 cm in front of (behind) the line along the top of the shoulder and the arm,
+      starting where the torso's shoulder point (|x| = 0.172 m, its placement) meets that line.
+So the shoulder seams lie on the shoulder ridge and the sleeves' top seams along the top of the arms, where the
+shirt hangs under gravity.
 """
 
-import json
 import sys
+from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).parent))
+from _strokes_common import (
+    Slicer,
+    cut,
+    edge_crossing,
+    pair,
+    sewn_point,
+    smooth,
+    torso_pair,
+    write_strokes_file,
+)
+
 from kitsuke.body import load_body
-from kitsuke.dressing import surface_length
-from kitsuke.geometry.surface import Surface
-from kitsuke.pattern import load_pattern, mesh_pattern
+from kitsuke.dressing import arc_length
+from kitsuke.pattern import load_pattern
 
-b = load_body("tests/data/bodies/mean_all.obj")
-v = b.mesh.vertices
-surf = Surface(b.mesh)
-pat = load_pattern("tests/data/pattern/shirt_mean_specification.json")
-pm = mesh_pattern(pat)
-
-
-def arm_y(x):
-    out = []
-    for xi in np.atleast_1d(x):
-        s = v[(np.abs(np.abs(v[:, 0]) - abs(xi)) < 0.008) & (v[:, 1] > 0.9) & (np.sign(v[:, 0]) == np.sign(xi))]
-        out.append(0.5 * (s[:, 1].min() + s[:, 1].max()))
-    return np.array(out)
+BODY = "tests/data/bodies/mean_all.obj"
+PATTERN = "tests/data/pattern/shirt_mean_specification.json"
+TORSO_U = 15.0  # cm from the centre line: the middle of the 4.4 cm shoulder seam (u 12.8 .. 17.2)
+TOP_GAP = 1.5  # cm between a torso stroke's start and the shoulder seam (and, on the body, the ridge)
+SHOULDER_Y = 1.43  # m, about the shoulder ridge height (picks the body section)
+CHEST_Y = 1.2  # m, torso strokes stop above this height
+SLEEVE_V = -2.5  # cm, the sleeve stroke's distance from the top seam (v = 0)
+END_GAP = 1.5  # cm, sleeve strokes keep this far from the armhole and the cuff
+FRONT_SHORT = 0.0  # m, front torso strokes stop this much above the chest's most prominent point
 
 
-def affine(name):
-    k = pm.piece_names.index(name)
-    v0, v1 = pm.piece_vertices[k]
-    A = np.c_[pm.vertices_cm[v0:v1], np.ones(v1 - v0)]
-    return np.linalg.lstsq(A, pm.positions_m[v0:v1], rcond=None)[0]
-
-
-def match_length(make_rays, hit, target_m, lo=0.3, hi=1.5):
-    """Scale factor of the body stroke so that its surface length matches target_m (bisection)."""
-    for _ in range(30):
-        mid = 0.5 * (lo + hi)
-        r = make_rays(mid)
-        sp = surf.cast(r[:, :3], r[:, 3:], hit=hit)
-        L = surface_length(surf, sp.points)
-        lo, hi = (mid, hi) if L < target_m else (lo, mid)
-    return 0.5 * (lo + hi)
-
-
-pairs = []
-sid = 1
-n = 9
-for name in pm.piece_names:
-    k = pm.piece_names.index(name)
-    v0, v1 = pm.piece_vertices[k]
-    cm = pm.vertices_cm[v0:v1]
-    lo_, hi_ = cm.min(0), cm.max(0)
-    M = affine(name)
-    if "torso" in name:
-        front = "ftorso" in name
-        u = -9.0 if lo_[0] < -1 else 9.0
-        x0 = (np.array([u, 0, 1]) @ M)[0]
-        zs = 1.0 if front else -1.0
-        v_top = 36.5 if front else 41.0
-        angles = [30.0, 50.0] if front else [30.0, 50.0, 65.0]
-
-        def rays(y_lo):
-            ys = np.linspace(y_lo, 1.36, 7)
-            r = [[x0, y, zs, 0, 0, -zs] for y in ys]
-            for a in np.radians(angles):
-                d = np.array([0, np.sin(a), zs * np.cos(a)])
-                o = np.array([x0, 1.36, 0.0]) + d
-                r.append([*o, *(-d)])
-            return np.array(r)
-
-        lo_y, hi_y = 0.9, 1.3
-        for _ in range(30):
-            mid = 0.5 * (lo_y + hi_y)
-            r = rays(mid)
-            L = surface_length(surf, surf.cast(r[:, :3], r[:, 3:], hit="first").points)
-            lo_y, hi_y = (lo_y, mid) if 100 * L < v_top - 4.0 else (mid, hi_y)
-        r = rays(0.5 * (lo_y + hi_y))
-        L = surface_length(surf, surf.cast(r[:, :3], r[:, 3:], hit="first").points)
-        pattern_pts = np.c_[np.full(len(r), u), np.linspace(4.0, 4.0 + 100 * L, len(r))]
-        pairs.append(
-            {
-                "id": sid,
-                "pattern": {"piece": name, "points": np.round(pattern_pts, 3).tolist()},
-                "body": {"laser": {"rays": np.round(r, 4).tolist(), "hit": "first"}},
-            }
-        )
-        print(name, "y_lo", round(0.5 * (lo_y + hi_y), 3), "L", round(L, 3))
-        sid += 1
-        continue
-    else:
-        # sleeve: along the long axis (u), at mid width
-        vm = 0.5 * (lo_[1] + hi_[1])
-        ua, ub = lo_[0] + 3.0, hi_[0] - 3.0
-        xa, xb = (np.array([ua, vm, 1]) @ M)[0], (np.array([ub, vm, 1]) @ M)[0]
-        if abs(xa) > abs(xb):
-            ua, ub, xa, xb = ub, ua, xb, xa  # from shoulder to cuff
-        Lp = abs(ub - ua) / 100
-        hit = "first" if name.endswith("_f") else "last"
-
-        def rays(s, xa=xa, xb=xb):
-            xs = xa + s * np.linspace(0, 1, n) * (xb - xa)
-            return np.c_[xs, arm_y(xs), np.full(n, 1.0), np.zeros(n), np.zeros(n), -np.ones(n)]
-
-        s = match_length(rays, hit, Lp, lo=0.5, hi=1.6)
-        pattern_pts = np.c_[np.linspace(ua, ub, n), np.full(n, vm)]
-        r = rays(s)
-    pairs.append(
+def main(out: str) -> None:
+    body = load_body(BODY)
+    pat = load_pattern(PATTERN)
+    sl = Slicer(body.mesh)
+    pairs = []
+    for side, sgn in (("right", -1.0), ("left", 1.0)):
+        # -- torso: front and back ------------------------------------------------------------------------------
+        for panel, toward in (("ftorso", 1.0), ("btorso", -1.0)):
+            piece = pat.piece(f"{side}_{panel}")
+            u = TORSO_U * (1.0 if piece.outline[:, 0].max() > 1 else -1.0)  # toward the side seam
+            short = FRONT_SHORT if toward > 0 else 0.0
+            pairs.append(
+                torso_pair(
+                    len(pairs) + 1,
+                    sl,
+                    piece,
+                    u,
+                    sgn * TORSO_U / 100,
+                    toward,
+                    near_y=SHOULDER_Y,
+                    top_gap_cm=TOP_GAP,
+                    min_y=CHEST_Y,
+                    short_m=short,
+                )
+            )
+        # -- sleeves: along the top of the arm, in front of / behind the top seam --------------------------------
+        # The sleeve's top corner at the shoulder end is sewn to the torso's shoulder point: where that hangs
+        # across (|x|) is taken from the pattern's own placement of the torso (0.172 m).
+        sleeve = pat.piece(f"{side}_sleeve_f")
+        corner = sleeve.outline[np.argmax(np.abs(sleeve.outline[:, 0]) - np.abs(sleeve.outline[:, 1]))]
+        torso, at = sewn_point(pat, sleeve.name, corner, to="torso")
+        x_sp = abs(float(pat.piece(torso).placement.apply(at)[0, 0]))
+        xs = sgn * np.arange(x_sp - 0.03, 0.62, 0.005)
+        top = smooth(sl.top_line(xs, SHOULDER_Y), 5)
+        s_top = arc_length(top)
+        s_sp = float(np.interp(x_sp, np.abs(xs), s_top))  # the torso's shoulder point on the top line
+        for panel, toward in (("sleeve_f", 1.0), ("sleeve_b", -1.0)):
+            name = f"{side}_{panel}"
+            piece = pat.piece(name)
+            lo, hi = piece.outline.min(0), piece.outline.max(0)
+            u_sh = lo[0] if abs(lo[0]) > abs(hi[0]) else hi[0]  # the top corner at the shoulder end
+            d = -np.sign(u_sh)  # pattern direction from the shoulder to the cuff
+            u_arm = edge_crossing(piece, SLEEVE_V, u_sh)  # the armhole edge at the stroke's height
+            u0, u1 = u_arm + d * END_GAP, -d * END_GAP  # cuff at u = 0
+            line = sl.around(top, -SLEEVE_V / 100, toward)
+            s_line = arc_length(line)
+            k0 = int(np.argmin(np.abs(s_top - (s_sp + abs(u0 - u_sh) / 100))))
+            length = min(abs(u1 - u0) / 100, s_line[-1] - s_line[k0] - 0.01)
+            pts = cut(line, s_line[k0], s_line[k0] + length)
+            pat_pts = np.c_[np.linspace(u0, u0 + d * 100 * length, len(pts)), np.full(len(pts), SLEEVE_V)]
+            pairs.append(pair(len(pairs) + 1, name, pat_pts, pts))
+    write_strokes_file(
+        pairs,
         {
-            "id": sid,
-            "pattern": {"piece": name, "points": np.round(pattern_pts, 3).tolist()},
-            "body": {"laser": {"rays": np.round(r, 4).tolist(), "hit": hit}},
-        }
+            "pattern": "GarmentCode shirt_mean_specification.json",
+            "body": "GarmentCode mean_all.obj",
+            "made_by": "tools/make_shirt_strokes.py",
+            "note": "hung from the shoulders: torso strokes from the shoulder ridge down the front and back "
+            "through the middle of the shoulder seam; sleeve strokes 2.5 cm below the sleeves' top seams along the "
+            "top of the arms from the shoulder point; drawn surface points, each pattern stroke as long as its "
+            "body stroke",
+        },
+        out,
     )
-    print(
-        name,
-        hit,
-        "scale",
-        round(s, 3),
-        "pattern",
-        pattern_pts[[0, -1]].round(1).tolist(),
-        "x",
-        r[[0, -1], 0].round(3).tolist(),
-        "y",
-        r[[0, -1], 1].round(3).tolist(),
-    )
-    sid += 1
-doc = {
-    "format": "kitsuke.strokes",
-    "version": 1,
-    "target": "body",
-    "pairs": pairs,
-    "meta": {
-        "pattern": "GarmentCode shirt_mean_specification.json",
-        "body": "GarmentCode mean_all.obj",
-        "note": "laser strokes from the front: torso panels vertical a third in from the centre line, sleeves along the arm; body strokes length-matched on the surface",
-    },
-}
-json.dump(doc, open(sys.argv[1], "w"), indent=1)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1] if len(sys.argv) > 1 else "src/kitsuke/assets/strokes/shirt_mean_all.json")

@@ -73,7 +73,12 @@ def packaged_strokes_path(name: str = "kimono_default") -> Path:
 
 
 def load_packaged_strokes(name: str = "kimono_default") -> Strokes:
-    """Read a packaged strokes file: "kimono_default" is the kimono (`default_kimono()`) on `default_body()`."""
+    """Read a packaged strokes file (src/kitsuke/assets/strokes/, see its SOURCES.md):
+
+    - "kimono_default": the kimono `kitsuke.pattern.default_kimono()` on `default_body()`;
+    - "shirt_mean_all", "hoody_mean_all": GarmentCode's shirt and hoody on GarmentCode's mean_all body;
+    - "tshirt_default": the FreeSewing Teagan T-shirt (sewn from its SVG) on `default_body()`.
+    """
     return read_strokes(packaged_strokes_path(name))
 
 
