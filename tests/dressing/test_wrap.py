@@ -215,15 +215,15 @@ def test_shirt_on_mean_all_structure(shirt):
 # -- the kimono on the default body --------------------------------------------------------------------------------
 def test_kimono_on_default_body(body):
     """default_kimono() with the shipped strokes at 1.5 cm edges, its waist held in the obi band (what `kitsuke
-    demo` dresses). Measured: no penetration, seams shared, strain mean 1.8 % and max 62 %, 4-16 inverted
+    demo` dresses). Measured: no penetration, seams shared, strain mean 1.8 % and max 62-78 %, 4-16 inverted
     triangles (of 28k; the count depends on the installed libraries' versions), stroke residual 6-17 mm
     (targets: 1 % / 5 % / 0 / 10 mm: NOT met)."""
     g = dress_default_kimono(body)
     r = g.report
     assert r.penetration_count == 0 and r.seam_gap_mm == 0.0
     assert r.strain_mean < 0.025  # measured 0.018
-    assert r.strain_max < 0.9  # measured 0.62
-    assert r.inverted_count <= 20  # measured 4 in session 2's environment, 16 on a fresh install 2026-11-24
+    assert r.strain_max < 0.9  # measured 0.62 (0.78 with the finish step)
+    assert r.inverted_count <= 20  # measured 4 (session 2), 16 (fresh install 2026-11-24), 6 (finish step)
     assert g.max_stroke_residual_m < 0.025  # measured 0.017
     _, counts = edge_topology(g.faces)
     assert counts.max() <= 2
