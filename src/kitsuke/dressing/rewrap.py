@@ -14,7 +14,8 @@ the dressed garment's surface. Steps:
    path over the cloth), scaled by a weight that is 1 on the stroke and falls smoothly to 0 at the pins
    (smoothstep of d_pin / (d_stroke + d_pin)); without pins the whole garment moves with its strokes.
 3. The global closing relaxation (`_solve.GlobalRelax`, body contacts inside the solve) with the stroke
-   triangles and the pins held, then a short gravity settle (the strokes still held unless `release_strokes`).
+   triangles and the pins held, then a short gravity settle (the strokes still held unless `release_strokes`),
+   then `kitsuke.cloth.untangle` opens the triangles left folded (the pins and strokes still held).
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, collide, relax
+from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, collide, relax, untangle
 from ..errors import InputError
 from ..geometry import TriMesh
 from ..geometry.surface import Surface
@@ -52,6 +53,7 @@ class RewrapParams:
     release_strokes : let the stroke triangles go for the settle. False (default) keeps them where the strokes
         put them: a part moved against gravity (a hem turned up, a sleeve lifted) would otherwise fall back.
     contact_weight : body contacts inside the global solve (see WrapParams).
+    untangle_rounds : most rounds of `kitsuke.cloth.untangle` at the end (see WrapParams).
     cloth : ClothParams of the relaxation.
     """
 
@@ -60,11 +62,20 @@ class RewrapParams:
     settle_iterations: int = 30
     release_strokes: bool = False
     contact_weight: float = 20.0
+    untangle_rounds: int = 10
     cloth: ClothParams = field(default_factory=lambda: ClothParams(max_stretch=None))
 
     def __post_init__(self) -> None:
-        if not (self.lift_m >= 0 and self.close_iterations >= 1 and self.settle_iterations >= 0):
-            raise InputError("rewrap parameters lift_m >= 0, close_iterations >= 1, settle_iterations >= 0 required")
+        if not (
+            self.lift_m >= 0
+            and self.close_iterations >= 1
+            and self.settle_iterations >= 0
+            and self.untangle_rounds >= 0
+        ):
+            raise InputError(
+                "rewrap parameters lift_m >= 0, close_iterations >= 1, settle_iterations >= 0, "
+                "untangle_rounds >= 0 required"
+            )
         if not self.contact_weight >= 0:
             raise InputError("rewrap parameter contact_weight must be >= 0")
 
@@ -227,6 +238,8 @@ def rewrap(
     state.pinned = pinned | (on_stroke & (not p.release_strokes))
     if p.settle_iterations:
         relax(model, state, collider, iterations=p.settle_iterations)
+    if p.untangle_rounds:
+        untangle(model, state, collider, rounds=p.untangle_rounds)
     state.positions[pinned] = g.positions[pinned]  # exactly still
     timings["relax"] = time.perf_counter() - t2
     timings["rewrap"] = time.perf_counter() - t0
