@@ -218,9 +218,7 @@ def torso_pair(
     shoulder seam), and on the body the path in the plane x = x_m from `top_gap_cm` past the shoulder ridge down
     the front (toward = +1) or back (-1) to where the chest (shoulder blade) stands out most, not below `min_y`
     (`Slicer.down_from_ridge`); the pattern stroke as long as the body stroke."""
-    pts, _ = slicer.down_from_ridge(
-        x_m, toward, near_y=near_y, start_m=top_gap_cm / 100, min_y=min_y, short_m=short_m
-    )
+    pts, _ = slicer.down_from_ridge(x_m, toward, near_y=near_y, start_m=top_gap_cm / 100, min_y=min_y, short_m=short_m)
     length_cm = 100 * float(arc_length(pts)[-1])
     v_top = pattern_top(piece, u_cm) - top_gap_cm
     if v_top - length_cm < 0.5:
@@ -240,7 +238,9 @@ def pair(pid: int, piece: str, pattern_cm: np.ndarray, body_m: np.ndarray) -> di
 
 def length_ratio(p: dict) -> float:
     """Body stroke length / pattern stroke length of a pair dict (1 = the stroke asks for no stretch)."""
-    return float(arc_length(np.array(p["body"]["points"]))[-1] / (arc_length(np.array(p["pattern"]["points"]))[-1] / 100))
+    return float(
+        arc_length(np.array(p["body"]["points"]))[-1] / (arc_length(np.array(p["pattern"]["points"]))[-1] / 100)
+    )
 
 
 def write_strokes_file(pairs: list[dict], meta: dict, out: str) -> None:

@@ -90,9 +90,7 @@ def main(out: str) -> None:
             path, s = path[::-1], s[-1] - s[::-1]
         s_j = float(s[np.argmin(np.linalg.norm(path - piece.edge_endpoints(crown)[edges[0] == crown], axis=1))])
         x = sgn * HOOD_INSET / 100
-        front, _ = sl.down_from_ridge(
-            x, 1.0, near_y=head_top_y, start_m=0.0, stop=(s[-1] - s_j - HOOD_FRONT_GAP) / 100
-        )
+        front, _ = sl.down_from_ridge(x, 1.0, near_y=head_top_y, start_m=0.0, stop=(s[-1] - s_j - HOOD_FRONT_GAP) / 100)
         back, _ = sl.down_from_ridge(x, -1.0, near_y=head_top_y, start_m=0.0, stop="prominent", min_y=NECK_Y)
         body_path = np.vstack([back[::-1], front[1:]])  # back of the skull -> top -> forehead
         lb, lf = float(arc_length(back)[-1]), float(arc_length(front)[-1])

@@ -1,7 +1,7 @@
 """The stroke files shipped in the package (src/kitsuke/assets/strokes/), each wrapped end to end on its body:
-GarmentCode's shirt and hoody on mean_all, the FreeSewing T-shirt on the default body (the kimono on the default
-body, with its obi band, is in test_wrap.py). Each case asserts its measured quality (SPEC §6) with a small margin,
-so a change that makes a shipped case worse fails here.
+GarmentCode's shirt and hoody on mean_all, the FreeSewing T-shirt (sewn by tools/make_tshirt_strokes.py) on the
+default body (the kimono on the default body, with its obi band, is in test_wrap.py). Each case asserts its
+measured quality (SPEC §6) with a small margin, so a change that makes a shipped case worse fails here.
 
 Issue 3's targets: penetration (none deeper than 2 mm), seam gap (≤ 3 mm) and no inverted triangle are met and
 asserted for every case; strain (mean ≤ 1 %, max ≤ 5 %) and stroke residual (≤ 10 mm) are NOT met by any case:
@@ -63,6 +63,17 @@ CASES = {
         0.025,
         (0.92, 1.10, 1.66, 1.78),
     ),
+    # measured 2026-11-24: strain 1.08 % / 24 % (18 % stretched, 24 % compressed), 0 inverted, residual 8-13 mm,
+    # no vertex inside, y 0.73 .. 1.41 m (cut for a 110 cm chest on an 84 cm one: it hangs loose to the thighs)
+    "tshirt": Case(
+        "tshirt_default",
+        DATA / "pattern" / "teagan_tshirt_cisMaleAdult42_sewn.json",
+        None,
+        0.015,
+        0.4,
+        0.02,
+        (0.65, 0.85, 1.35, 1.47),
+    ),
 }
 
 
@@ -104,7 +115,7 @@ def test_garment_sits_where_it_should(dressed):
     assert lo_a < y.min() < lo_b and hi_a < y.max() < hi_b
 
 
-@pytest.mark.xfail(strict=True, reason="issue 3 targets not met: strain ~1.5 % mean / 30-60 % max, residual ~17 mm")
+@pytest.mark.xfail(strict=True, reason="issue 3 targets not met: strain 1.1-1.5 % mean, 24-60 % max, residual 13-18 mm")
 def test_issue_targets(dressed):
     _, g = dressed
     r = g.report
