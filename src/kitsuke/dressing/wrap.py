@@ -75,9 +75,10 @@ class WrapParams:
         under its own weight; these steps take that back and keep the drape (shirt mean strain 2.13 -> 1.43 %,
         hoody 2.08 -> 1.41 %; more iterations lower it further but let cloth sink into the body: 40 iterations,
         14 vertices up to 6 mm deep).
-    untangle_rounds : most rounds of `kitsuke.cloth.untangle` at the end (0: none). Measured on GarmentCode's
-        hoody on mean_all: 7 folded triangles at the neckline after the finish, 0 after one round, the rest of
-        the garment untouched.
+    untangle_rounds : most rounds of `kitsuke.cloth.untangle` after the close and at the end (0: none). Measured
+        on GarmentCode's hoody on mean_all: 7 folded triangles at the neckline after the finish, 0 after one
+        round, the rest of the garment untouched; the kimono: 16 -> 0 (one of them inside the obi band, which
+        only the untangle after the close can reach).
     release_strokes : unpin the stroke triangles for the settle (the paper lets the garment settle freely);
         False keeps them where the strokes put them.
     hold_band_m : (low, high) heights in metres, or None: garment vertices in this band are pinned for the settle
