@@ -258,6 +258,8 @@ def test_wrap_rejects_a_missing_piece_and_bad_params():
         WrapParams(hold_band_m=(1.0, 0.9))
     with pytest.raises(InputError, match="stroke_hold"):
         WrapParams(stroke_hold=-0.1)
+    with pytest.raises(InputError, match="untangle_rounds"):
+        WrapParams(untangle_rounds=-1)
     with pytest.raises(InputError, match="no strokes"):
         wrap(_sphere(), _square(), Strokes([]))
     garment_target = Strokes(_sheet_strokes(0.3).pairs, target="garment")
