@@ -220,3 +220,23 @@ def test_from_body_puts_the_floor_under_the_feet(body, body_collider):
     assert BodyCollider.from_body(body, floor=False).floor_y is None
     with pytest.raises(InputError, match="floor_y"):
         BodyCollider.from_mesh(body.mesh, floor_y=float("nan"))
+
+
+def test_forget_finds_a_vertex_pushed_into_a_neighbouring_surface():
+    """Two spheres 1 cm apart (an arm beside the torso): a vertex tracked on A, moved 4 mm into B, is still near A,
+    so the walk keeps it on A, outside. `Contacts.forget` makes the next update search globally: it finds B and
+    the vertex is pushed out of it."""
+    a, b = icosphere(0.1, 3), icosphere(0.1, 3, centre=(0.21, 0.0, 0.0))
+    two = TriMesh(np.r_[a.vertices, b.vertices], np.r_[a.faces, b.faces + len(a.vertices)])
+    col = BodyCollider.from_mesh(two)
+    model, state = point_cloud_model(np.array([[0.104, 0.0, 0.0], [0.0, 0.6, 0.0], [0.0, 0.7, 0.0]]))
+    collide(model, state, col)
+    assert state.contacts.face[0] < len(a.faces)
+    state.positions[0] = [0.114, 0.0, 0.0]  # 4 mm inside B, 14 mm from A
+    collide(model, state, col)
+    assert state.contacts.face[0] < len(a.faces) and state.contacts.distance[0] > 0  # the walk's blind spot
+    assert penetration(state.positions[:1], two).count == 1
+    state.contacts.forget()
+    collide(model, state, col)
+    assert state.contacts.face[0] >= len(a.faces)
+    assert penetration(state.positions[:1], two, threshold_m=0.0).count == 0

@@ -237,6 +237,8 @@ def rewrap(
         solver.step(state, collider)
     state.pinned = pinned | (on_stroke & (not p.release_strokes))
     if p.settle_iterations:
+        # The Jacobi settle, not the wrap's global one: with the strokes held, the global settle left a triangle
+        # folded against the held stroke row that the untangle cannot open (kimono, hem turned up: 1 vs 0).
         relax(model, state, collider, iterations=p.settle_iterations)
     if p.untangle_rounds:
         untangle(model, state, collider, rounds=p.untangle_rounds)
