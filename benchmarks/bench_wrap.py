@@ -1,6 +1,6 @@
 """Benchmark: wrap + settle of GarmentCode's shirt (1.5 cm edges) on mean_all with the packaged strokes.
 
-    /work/venv/bin/python benchmarks/bench_wrap.py [--repeat 5]
+    python benchmarks/bench_wrap.py [--repeat 5] [--settle global]
 
 Prints the per-step timings of each run after a warm-up run (numba compilation, AABB trees) and the quality.
 """
@@ -19,11 +19,12 @@ ROOT = Path(__file__).resolve().parents[1]
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--settle", choices=["jacobi", "global"], default="jacobi", help="WrapParams.settle")
     args = ap.parse_args()
     from kitsuke.body import load_body
     from kitsuke.cloth import BodyCollider
     from kitsuke.dressing import read_strokes, resolve_strokes
-    from kitsuke.dressing.wrap import wrap
+    from kitsuke.dressing.wrap import WrapParams, wrap
     from kitsuke.geometry.surface import Surface
     from kitsuke.pattern import load_pattern, mesh_pattern
 
@@ -33,11 +34,12 @@ def main() -> None:
     pm = mesh_pattern(pattern, edge_length=1.5)
     resolved = resolve_strokes(strokes, pattern, Surface(body.mesh), pattern_mesh=pm)
     collider = BodyCollider.from_body(body)
-    wrap(body, pm, resolved, collider=collider, report=False)  # warm-up
+    params = WrapParams() if args.settle == "jacobi" else WrapParams(settle="global", settle_iterations=30)
+    wrap(body, pm, resolved, collider=collider, params=params, report=False)  # warm-up
     walls = []
     for _ in range(args.repeat):
         t = time.perf_counter()
-        g = wrap(body, pm, resolved, collider=collider, report=False)
+        g = wrap(body, pm, resolved, collider=collider, params=params, report=False)
         walls.append(time.perf_counter() - t)
         print("  ".join(f"{k} {v * 1e3:.0f} ms" for k, v in g.timings.items()))
     print(
@@ -49,7 +51,7 @@ def main() -> None:
         f"min {min(walls):.3f} s over {args.repeat} runs"
     )
     t = time.perf_counter()
-    g = wrap(body, pattern, strokes)
+    g = wrap(body, pattern, strokes, params=params)
     print(
         f"from files' objects (meshing, stroke resolution, collider, report included): {time.perf_counter() - t:.3f} s"
     )

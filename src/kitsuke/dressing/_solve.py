@@ -86,7 +86,7 @@ class GlobalRelax:
         self.gravity_m = float(gravity_m)
         self.stick_weight = float(stick_weight)
         self.stuck: np.ndarray | None = None  # vertices held by static friction, set at the first step
-        self.stick_at = np.zeros((nv, 3))
+        self.stick_at: np.ndarray | None = None  # (V, 3) where they were then
         self.released = np.zeros(nv, dtype=bool)
         self.cg_iterations = 0
         self.pinned = pinned.copy()
@@ -159,20 +159,15 @@ class GlobalRelax:
         if ws > 0:
             if self.stuck is None:
                 self.stuck = touching.copy()
-                self.stick_at[:] = state.positions
+                self.stick_at = state.positions.copy()
                 self._precondition_sticks()
             self.stuck &= touching  # held until it leaves the body (not when it only rises off its plane)
         idx = np.flatnonzero(touching & ~self.released)
         n = c.normal[idx]
         q = c.point[idx] + offset * n
-        if self.stuck is not None:  # tangential springs to where each stuck vertex was: (I - n n^T) (x - s)
-            si = np.flatnonzero(self.stuck)
-            sn = c.normal[si]
-            s_at = self.stick_at[si]
-            rhs = rhs.copy()
-            rhs[si] += ws * (s_at - sn * (sn * s_at).sum(axis=1, keepdims=True))
-        else:
-            si = np.zeros(0, dtype=np.int64)
+        # Tangential springs to where each stuck vertex was: ws (I - n n^T) (x - s).
+        si = np.zeros(0, dtype=np.int64) if self.stuck is None else np.flatnonzero(self.stuck)
+        sn = c.normal[si]
         if collider.floor_y is not None:  # the floor: one more plane for the vertices near it
             low = np.flatnonzero((state.positions[:, 1] < collider.floor_y + reach) & ~self.pinned)
             idx = np.concatenate([idx, low])
@@ -183,6 +178,9 @@ class GlobalRelax:
         w = self.contact_weight
         b = rhs.copy()
         np.add.at(b, idx, w * n * (n * q).sum(axis=1, keepdims=True))
+        if len(si):
+            s_at = self.stick_at[si]
+            b[si] += ws * (s_at - sn * (sn * s_at).sum(axis=1, keepdims=True))
 
         def apply(x: np.ndarray) -> np.ndarray:
             y = self.a @ x
@@ -228,16 +226,16 @@ def gravity_settle(
     stick_weight: float,
     contact_weight: float,
 ) -> None:
-    """The settle of the wrap and the re-wrap (in place on `state`): `iterations` global steps with gravity
-    (`gravity_m` per step for a free vertex), the body contacts inside the solve and static friction holding
-    the cloth that touches the body at the start (`stick_weight`); `pinned` vertices stay.
+    """The wrap's `settle="global"` (in place on `state`): `iterations` global steps with gravity (`gravity_m`
+    per step for a free vertex), the body contacts inside the solve and static friction holding the cloth that
+    touches the body at the start (`stick_weight`); `pinned` vertices stay.
 
-    Why not `kitsuke.cloth.relax` with gravity (the settle up to 2026-11-24): its Jacobi averaging lets gravity
+    Why besides `kitsuke.cloth.relax` with gravity (the default settle): its Jacobi averaging lets gravity
     stretch the cloth hanging below what holds it, in proportion to the length that hangs (the kimono under its
-    obi band: a row of edges 8-30 % long), which a later global pass only partly takes back. Here the solve is
+    obi band: a row of edges 8-30 % long), which the wrap's finish only partly takes back. Here the solve is
     stiff everywhere at once, so cloth that hangs swings down without stretching. Measured on the four shipped
-    cases (mean edge strain, Jacobi -> global): shirt 1.43 -> 1.35 %, hoody 1.51 -> 1.44 %, T-shirt 1.08 ->
-    1.04 %, kimono 1.79 -> 1.27 %.
+    cases (mean edge strain, Jacobi -> global, see WrapParams.settle): shirt 1.43 -> 1.36 %, hoody 1.51 ->
+    1.40 %, T-shirt 1.08 -> 1.02 %, kimono 1.79 -> 1.19 %.
     """
     solver = GlobalRelax(model, pinned, contact_weight=contact_weight, gravity_m=gravity_m, stick_weight=stick_weight)
     for _ in range(iterations):

@@ -74,7 +74,7 @@ class WrapParams:
         gravity, friction and collision; "global": `settle_iterations` (30 is enough) global steps
         (`_solve.gravity_settle`) with gravity `settle_gravity_m` per step and static friction `stick_weight`.
         The global settle does not stretch hanging cloth (mean strain, jacobi -> global: shirt 1.43 -> 1.36 %,
-        hoody 1.51 -> 1.39 %, T-shirt 1.08 -> 1.02 %, kimono 1.79 -> 1.19 %) but costs ~0.4 s more on the shirt,
+        hoody 1.51 -> 1.39 %, T-shirt 1.08 -> 1.02 %, kimono 1.79 -> 1.19 %), costs ~0.1 s more on the shirt,
         and rolling up a sleeve of the 3 cm kimono settled that way leaves one folded triangle that the drag's
         untangle does not open (0 with the Jacobi settle); so it is not yet the default.
     settle_iterations : iterations (jacobi) or steps (global) of the settle.
@@ -95,10 +95,10 @@ class WrapParams:
         False keeps them where the strokes put them.
     hold_band_m : (low, high) heights in metres, or None: garment vertices in this band are pinned for the settle
         (a kimono's waist, held by the obi).
-    cloth : ClothParams of the Jacobi relaxation during growth (without gravity), of the untangle and of the
-        returned model (a later drag). Strain limiting is off by default: where the grown garment is still
-        strained at seams, it would drag the whole garment towards its supports in one iteration (measured on
-        the shirt: the shirt ends up a scarf).
+    cloth : ClothParams of the Jacobi relaxation (growth, without gravity; the default settle, with it), of the
+        untangle and of the returned model (a later drag). Strain limiting is off by default: where the grown
+        garment is still strained at seams, it would drag the whole garment towards its supports in one
+        iteration (measured on the shirt: the shirt ends up a scarf).
     """
 
     edge_length_cm: float = 1.5
