@@ -177,3 +177,21 @@ def segment_segment_distance(p1, q1, p2, q2, samples: int = 20001):
     u = q2 - p2
     t = np.clip((x - p2) @ u / (u @ u), 0, 1)[:, None]
     return np.linalg.norm(x - (p2 + t * u), axis=1).min()
+
+
+def project_lengths(pos, edges, rest, movable, order):
+    """One Gauss-Seidel sweep in `order`: each edge's movable ends moved along it, equally, to its rest length."""
+    pos = pos.copy()
+    worst = 0.0
+    for e in order:
+        a, b = edges[e]
+        w = np.array([movable[a], movable[b]], dtype=float)
+        if w.sum() == 0:
+            continue
+        d = pos[b] - pos[a]
+        length = np.linalg.norm(d)
+        worst = max(worst, abs(length - rest[e]))
+        corr = (length - rest[e]) / w.sum() * d / length
+        pos[a] += w[0] * corr
+        pos[b] -= w[1] * corr
+    return pos, worst

@@ -160,3 +160,20 @@ def test_support_order_and_limit_strain_match(crumpled, rng):
     np.testing.assert_allclose(got, expect, atol=ATOL)
     assert not np.allclose(got, pos)
     np.testing.assert_array_equal(got[~movable], pos[~movable])
+
+
+def test_project_lengths_matches_reference_and_keeps_fixed_vertices(crumpled, rng):
+    model, pos = crumpled
+    movable = rng.random(model.n_vertices) > 0.2
+    order = rng.permutation(model.n_edges).astype(np.int64)
+    got = pos.copy()
+    worst = K.project_lengths(got, model.edges, model.rest_lengths, movable, order)
+    expect, expect_worst = ref.project_lengths(pos, model.edges, model.rest_lengths, movable, order)
+    np.testing.assert_allclose(got, expect, atol=ATOL)
+    assert worst == pytest.approx(expect_worst)
+    np.testing.assert_array_equal(got[~movable], pos[~movable])
+    # The last edge of the sweep ends at its rest length if one of its ends could move.
+    last = order[-1]
+    if movable[model.edges[last]].any():
+        a, b = model.edges[last]
+        assert np.linalg.norm(got[b] - got[a]) == pytest.approx(model.rest_lengths[last])

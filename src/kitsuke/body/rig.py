@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -36,6 +36,11 @@ class Rig:
     def joint(self, name: str) -> np.ndarray:
         """(3,) rest position of a named joint."""
         return self.joints[joint_index(name)]
+
+    def weight_of(self, names: Sequence[str]) -> np.ndarray:
+        """(V,) float64: each vertex's summed skin weight of the bones starting at the joints `names` (e.g.
+        ("pelvis", "spine", "chest"): how much the torso moves it)."""
+        return self.weights[:, [joint_index(n) for n in names]].sum(axis=1)
 
 
 RotationLike = Any  # (3, 3) matrix, (3,) rotation vector in radians, (4,) quaternion w x y z, or scipy Rotation

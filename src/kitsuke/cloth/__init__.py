@@ -1,4 +1,4 @@
-"""Cloth core: the static model, the relaxation of the paper, Skin-style body collision with capsule bones,
+"""Cloth core: the static model, the relaxation of the paper, edge-length restoration, Skin-style body collision with capsule bones,
 adaptive sqrt(3) subdivision, and untangling of folded triangles.
 
 Typical use::
@@ -13,6 +13,7 @@ small move down, and collision pushes the cloth out of the body. Constants live 
 """
 
 from ._collide import BodyCollider, CollisionStats, collide, track, vertex_active
+from ._lengths import LengthStats, restore_lengths
 from ._model import ClothModel, ClothParams, ClothState, Contacts, locality_order
 from ._relax import RelaxStats, relax
 from ._shapes import grid_sheet, grid_tube, hugging_tube, triangle_frames
@@ -26,6 +27,7 @@ __all__ = [
     "ClothState",
     "CollisionStats",
     "Contacts",
+    "LengthStats",
     "Refinement",
     "RelaxStats",
     "UntangleStats",
@@ -38,6 +40,7 @@ __all__ = [
     "locality_order",
     "refine",
     "relax",
+    "restore_lengths",
     "sqrt3_split",
     "track",
     "triangle_frames",

@@ -331,6 +331,37 @@ def limit_strain(order, n_order, rank, movable, adj_ptr, adj, adj_edge, rest_len
                 pos[i, 2] = pos[k, 2] + dz * f
 
 
+@njit(cache=True)
+def project_lengths(pos, edges, rest_lengths, movable, order):
+    """One Gauss-Seidel sweep (in place on pos (V, 3)): each edge in `order` moves its movable ends, half each
+    (all of it for one movable end), along the edge until it has its rest length. Returns the largest length
+    error met in the sweep, metres (before its correction). Sequential on purpose: each projection sees the
+    previous ones, which is what makes a sweep converge where a Jacobi average would cancel itself out.
+    """
+    worst = 0.0
+    for o in range(len(order)):
+        e = order[o]
+        a, b = edges[e, 0], edges[e, 1]
+        wa = 1.0 if movable[a] else 0.0
+        wb = 1.0 if movable[b] else 0.0
+        if wa + wb == 0.0:
+            continue
+        dx, dy, dz = pos[b, 0] - pos[a, 0], pos[b, 1] - pos[a, 1], pos[b, 2] - pos[a, 2]
+        d = math.sqrt(dx * dx + dy * dy + dz * dz)
+        if d * d < TINY2:
+            continue
+        err = d - rest_lengths[e]
+        worst = max(worst, abs(err))
+        f = err / (d * (wa + wb))
+        pos[a, 0] += wa * f * dx
+        pos[a, 1] += wa * f * dy
+        pos[a, 2] += wa * f * dz
+        pos[b, 0] -= wb * f * dx
+        pos[b, 1] -= wb * f * dy
+        pos[b, 2] -= wb * f * dz
+    return worst
+
+
 def set_parallel(parallel: bool) -> None:
     """Recompile the per-element kernels with or without threads (for benchmarks; not cached)."""
     g = globals()

@@ -51,6 +51,27 @@ def folded_faces(model: ClothModel, state: ClothState) -> np.ndarray:
     return flipped.astype(bool)
 
 
+#: Umbrella smoothing passes over a fold that a round of relaxation left shut.
+SMOOTH_PASSES = 3
+
+
+def _smooth(model: ClothModel, pos: np.ndarray, region: np.ndarray, passes: int) -> None:
+    """Move each vertex of `region` (V,) bool to the mean of its edge neighbours, `passes` times (in place on
+    pos (V, 3)). A fold pressed shut between two body parts (a kimono's armpit after a lift) stays shut under
+    shape matching, whose goals are the folded triangles' own best fits; averaging with the neighbours takes the
+    crease out of the geometry and lets the next relaxation start from an open surface."""
+    e = model.edges
+    idx = np.flatnonzero(region)
+    if not len(idx):
+        return
+    deg = np.bincount(e.reshape(-1), minlength=len(pos)).astype(np.float64)
+    for _ in range(passes):
+        acc = np.zeros_like(pos)
+        np.add.at(acc, e[:, 0], pos[e[:, 1]])
+        np.add.at(acc, e[:, 1], pos[e[:, 0]])
+        pos[idx] = acc[idx] / np.maximum(deg[idx], 1.0)[:, None]
+
+
 def grow_region(faces: np.ndarray, vertices: np.ndarray, rings: int) -> np.ndarray:
     """(V,) bool: `vertices` (V,) bool and every vertex within `rings` triangle rings of them."""
     region = vertices.copy()
@@ -93,6 +114,8 @@ def untangle(
         # A fold that survives a round gets a wider region the next: what holds it shut may lie farther out.
         free = grow_region(model.faces, seed, rings + stats.rounds) & ~pinned
         moved |= free
+        if stats.rounds >= rounds // 2:  # half the rounds of relaxing alone did not open it: flatten it first
+            _smooth(model, state.positions, grow_region(model.faces, seed, 1) & ~pinned, SMOOTH_PASSES)
         state.pinned = ~free
         try:
             relax(local, state, collider, iterations=iterations)

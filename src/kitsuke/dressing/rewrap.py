@@ -15,7 +15,7 @@ the dressed garment's surface. Steps:
    (smoothstep of d_pin / (d_stroke + d_pin)); without pins the whole garment moves with its strokes.
 3. The global closing relaxation (`_solve.GlobalRelax`, body contacts inside the solve) with the stroke
    triangles and the pins held, then a short gravity settle (the strokes still held unless `release_strokes`),
-   then `kitsuke.cloth.untangle` opens the triangles left folded (the pins and strokes still held).
+   then edge-length restoration (`kitsuke.cloth.restore_lengths`), and `kitsuke.cloth.untangle` opens the triangles left folded (the pins and strokes still held).
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, collide, relax, untangle
+from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, collide, relax, restore_lengths, untangle
 from ..errors import InputError
 from ..geometry import TriMesh
 from ..geometry.surface import Surface
@@ -53,6 +53,8 @@ class RewrapParams:
     release_strokes : let the stroke triangles go for the settle. False (default) keeps them where the strokes
         put them: a part moved against gravity (a hem turned up, a sleeve lifted) would otherwise fall back.
     contact_weight : body contacts inside the global solve (see WrapParams).
+    length_sweeps : sweeps of `kitsuke.cloth.restore_lengths` after the settle, pins and held strokes kept (see
+        WrapParams).
     untangle_rounds : most rounds of `kitsuke.cloth.untangle` at the end (see WrapParams).
     cloth : ClothParams of the relaxation.
     """
@@ -62,6 +64,7 @@ class RewrapParams:
     settle_iterations: int = 30
     release_strokes: bool = False
     contact_weight: float = 20.0
+    length_sweeps: int = 300
     untangle_rounds: int = 10
     cloth: ClothParams = field(default_factory=lambda: ClothParams(max_stretch=None))
 
@@ -71,10 +74,11 @@ class RewrapParams:
             and self.close_iterations >= 1
             and self.settle_iterations >= 0
             and self.untangle_rounds >= 0
+            and self.length_sweeps >= 0
         ):
             raise InputError(
                 "rewrap parameters lift_m >= 0, close_iterations >= 1, settle_iterations >= 0, "
-                "untangle_rounds >= 0 required"
+                "untangle_rounds >= 0, length_sweeps >= 0 required"
             )
         if not self.contact_weight >= 0:
             raise InputError("rewrap parameter contact_weight must be >= 0")
@@ -240,6 +244,8 @@ def rewrap(
         # The Jacobi settle, not the wrap's global one: with the strokes held, the global settle left a triangle
         # folded against the held stroke row that the untangle cannot open (kimono, hem turned up: 1 vs 0).
         relax(model, state, collider, iterations=p.settle_iterations)
+    if p.length_sweeps:  # as the wrap ends: the local strain the relaxation leaves
+        restore_lengths(model, state, collider, sweeps=p.length_sweeps)
     if p.untangle_rounds:
         untangle(model, state, collider, rounds=p.untangle_rounds)
     state.positions[pinned] = g.positions[pinned]  # exactly still
