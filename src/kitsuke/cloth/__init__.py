@@ -1,5 +1,5 @@
-"""Cloth core: the static model, the relaxation of the paper, edge-length restoration, Skin-style body collision with capsule bones,
-adaptive sqrt(3) subdivision, and untangling of folded triangles.
+"""Cloth core: the static model, the relaxation of the paper, edge-length restoration, Skin-style body collision
+with capsule bones, adaptive sqrt(3) subdivision, and untangling of folded triangles.
 
 Typical use::
 

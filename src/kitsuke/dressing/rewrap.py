@@ -15,7 +15,8 @@ the dressed garment's surface. Steps:
    (smoothstep of d_pin / (d_stroke + d_pin)); without pins the whole garment moves with its strokes.
 3. The global closing relaxation (`_solve.GlobalRelax`, body contacts inside the solve) with the stroke
    triangles and the pins held, then a short gravity settle (the strokes still held unless `release_strokes`),
-   then edge-length restoration (`kitsuke.cloth.restore_lengths`), and `kitsuke.cloth.untangle` opens the triangles left folded (the pins and strokes still held).
+   then edge-length restoration (`kitsuke.cloth.restore_lengths`), and `kitsuke.cloth.untangle` opens the
+   triangles left folded (the pins and strokes still held).
 """
 
 from __future__ import annotations

@@ -101,7 +101,8 @@ class WrapParams:
     hold_band_m : (low, high) heights in metres, or None: garment vertices in this band are pinned for the settle
         (a kimono's waist, held by the obi), where they are within `hold_reach_m` of the body.
     hold_reach_m : metres; the hold band holds only cloth this close to the body and, on a rigged body, over the
-        torso (what a tied obi presses on; the kimono's overlapping fronts and its looser folds lie centimetres out). See `_band_held`.
+        torso (what a tied obi presses on; the kimono's overlapping fronts and looser folds lie centimetres out).
+        See `_band_held`.
     cloth : ClothParams of the Jacobi relaxation (growth, without gravity; the default settle, with it), of the
         untangle and of the returned model (a later drag). Strain limiting is off by default: where the grown
         garment is still strained at seams, it would drag the whole garment towards its supports in one
