@@ -201,18 +201,17 @@ def shirt() -> DressedGarment:
 
 
 def test_global_settle_strains_the_shirt_less(shirt):
-    """settle="global" (`_solve.gravity_settle`): the same shirt, less strained than with the Jacobi settle
-    (measured 2026-11-24: 1.36 % against 1.46 % mean), still outside the body and without folded triangles."""
-    g = wrap(
-        load_body(MEAN_ALL),
-        load_pattern(SHIRT),
-        read_strokes(SHIRT_STROKES),
-        params=WrapParams(settle="global", settle_iterations=30),
-    )
+    """settle="global" (`_solve.gravity_settle`) on its own, without the finish and the length restoration that
+    follow either settle: the same shirt, less strained than after the Jacobi settle (measured 2026-11-24: 1.8 %
+    against 2.6 % mean), still outside the body and without folded triangles."""
+    body, pattern, strokes = load_body(MEAN_ALL), load_pattern(SHIRT), read_strokes(SHIRT_STROKES)
+    bare = dict(finish_iterations=0, length_sweeps=0)
+    jacobi = wrap(body, pattern, strokes, params=WrapParams(**bare))
+    g = wrap(body, pattern, strokes, params=WrapParams(settle="global", settle_iterations=30, **bare))
     r = g.report
-    assert r.strain_mean < shirt.report.strain_mean - 0.0005
+    assert r.strain_mean < jacobi.report.strain_mean - 0.002
     assert r.penetration_count == 0 and r.inverted_count == 0 and r.seam_gap_mm == 0.0
-    assert g.max_stroke_residual_m < 0.025  # measured 20 mm
+    assert g.max_stroke_residual_m < 0.025
 
 
 def test_shirt_on_mean_all_structure(shirt):
@@ -230,16 +229,16 @@ def test_shirt_on_mean_all_structure(shirt):
 # -- the kimono on the default body --------------------------------------------------------------------------------
 def test_kimono_on_default_body(body):
     """default_kimono() with the shipped strokes at 1.5 cm edges, its waist held in the obi band (what `kitsuke
-    demo` dresses). Measured 2026-11-24: no penetration, seams shared, no folded triangle (untangled: 4-16 before
-    that step, depending on the installed libraries' versions), strain mean 1.8 % and max 62-78 % (a few hem and
-    sleeve-bag edges), stroke residual 17 mm (targets: 1 % / 5 % / 10 mm: NOT met)."""
+    demo` dresses). Measured 2026-11-24: no penetration, seams shared, no folded triangle, strain mean 0.89 % and
+    max 70 % (sleeve-bag edges), stroke residual 20 mm (targets: 1 % / 5 % / 10 mm: the max and the residual NOT
+    met)."""
     g = dress_default_kimono(body)
     r = g.report
     assert r.penetration_count == 0 and r.seam_gap_mm == 0.0
-    assert r.strain_mean < 0.025  # measured 0.018
-    assert r.strain_max < 0.9  # measured 0.62 (0.78 with the finish step)
+    assert r.strain_mean < 0.01  # measured 0.0089
+    assert r.strain_max < 0.9  # measured 0.70
     assert r.inverted_count == 0
-    assert g.max_stroke_residual_m < 0.025  # measured 0.017
+    assert g.max_stroke_residual_m < 0.025  # measured 0.020
     _, counts = edge_topology(g.faces)
     assert counts.max() <= 2
     # It hangs from the shoulders down to the ankles, above the floor; the obi band is held.
@@ -247,7 +246,14 @@ def test_kimono_on_default_body(body):
     assert 1.35 < y.max() < 1.60 and 0.0 < y.min() < 0.15
     low, high = obi_band(body)
     assert 0.9 < low < 1.05 and high - low == pytest.approx(OBI_WIDTH_M)
-    assert g.pinned.any() and ((y[g.pinned] >= low) & (y[g.pinned] <= high)).all()
+    # The band held the cloth over the torso, not the sleeves hanging over the forearms at that height; the
+    # finish (no gravity) let it go, so it may have moved by millimetres.
+    assert g.pinned.sum() > 100 and ((y[g.pinned] >= low - 0.01) & (y[g.pinned] <= high + 0.01)).all()
+    sleeves = np.zeros(g.n_vertices, dtype=bool)
+    for k, name in enumerate(g.piece_names):
+        if name.startswith("sode"):
+            sleeves[g.faces[g.piece_faces[k, 0] : g.piece_faces[k, 1]].reshape(-1)] = True
+    assert not (g.pinned & sleeves).any()
 
 
 # -- bad input -----------------------------------------------------------------------------------------------------
