@@ -3,10 +3,10 @@ GarmentCode's shirt and hoody on mean_all, the FreeSewing T-shirt (sewn by tools
 default body (the kimono on the default body, with its obi band, is in test_wrap.py). Each case asserts its
 measured quality (SPEC §6) with a small margin, so a change that makes a shipped case worse fails here.
 
-Issue 3's targets: penetration (none deeper than 2 mm), seam gap (≤ 3 mm) and no inverted triangle are met and
-asserted for every case; strain (mean ≤ 1 %, max ≤ 5 %) and stroke residual (≤ 10 mm) are NOT met by any case:
-`test_issue_targets` states them as a strict expected failure, so the day they are met the suite says so (and
-the marker must go)."""
+Issue 3's targets: penetration (none deeper than 2 mm), seam gap (≤ 3 mm), no inverted triangle and mean strain
+(≤ 1 %) are met and asserted for every case; max strain (≤ 5 %) and stroke residual (≤ 10 mm) are NOT met by any
+case: `test_issue_targets` states them as a strict expected failure, so the day they are met the suite says so
+(and the marker must go)."""
 
 from __future__ import annotations
 
@@ -33,43 +33,40 @@ class Case:
     strokes: str  # packaged stroke file name, without .json
     pattern: Path
     body: Path | None  # None: the default body
-    strain_mean: float
     strain_max: float
     residual_m: float
     y_range: tuple[float, float, float, float]  # garment lowest y in [a, b], highest y in [c, d] (metres)
 
 
 CASES = {
-    # measured 2026-11-24: strain 1.43 % / 33 %, 0 inverted (1 before untangling), residual 18 mm, deepest 1.3 mm,
-    # y 1.02 .. 1.45 m (before the wrap's finish step: 2.13 % / 44 %)
+    # measured 2026-11-24: strain 0.81 % / 30 %, 0 inverted, residual 21 mm, deepest 1.7 mm, y 1.02 .. 1.45 m
+    # (before the length restoration: 1.43 % / 33 %, 18 mm; before the finish step: 2.13 % / 44 %)
     "shirt": Case(
         "shirt_mean_all",
         DATA / "pattern" / "shirt_mean_specification.json",
         DATA / "bodies" / "mean_all.obj",
-        0.018,
         0.45,
         0.025,
         (0.95, 1.10, 1.38, 1.50),
     ),
-    # measured 2026-11-24: strain 1.41-1.56 % / 30-59 % (the max is a crumple at the front neckline; it moved
-    # between 30 % and 59 % with the installed libraries' versions), 0 inverted (3-7 before untangling), residual
-    # 16-17 mm, deepest 1.6 mm, y 0.99 .. 1.72 m (the hood reaches over the top of the head)
+    # measured 2026-11-24: strain 0.94 % / 21 % (the max is where the hood meets the neckline; before the length
+    # restoration 1.41-1.56 % / 30-59 %, moving with the installed libraries' versions), 0 inverted, residual
+    # 22 mm, y 0.99 .. 1.72 m (the hood reaches over the top of the head)
     "hoody": Case(
         "hoody_mean_all",
         DATA / "pattern" / "hoody_mean_specification.json",
         DATA / "bodies" / "mean_all.obj",
-        0.02,
-        0.7,
+        0.5,
         0.025,
         (0.92, 1.10, 1.66, 1.78),
     ),
-    # measured 2026-11-24: strain 1.08 % / 24 % (18 % stretched, 24 % compressed), 0 inverted, residual 8-13 mm,
-    # no vertex inside, y 0.73 .. 1.41 m (cut for a 110 cm chest on an 84 cm one: it hangs loose to the thighs)
+    # measured 2026-11-24: strain 0.46 % / 24 %, 0 inverted, residual 15 mm (before the length restoration:
+    # 1.08 %, 8-13 mm), no vertex inside, y 0.73 .. 1.41 m (cut for a 110 cm chest on an 84 cm one: it hangs
+    # loose to the thighs)
     "tshirt": Case(
         "tshirt_default",
         DATA / "pattern" / "teagan_tshirt_cisMaleAdult42_sewn.json",
         None,
-        0.015,
         0.4,
         0.02,
         (0.65, 0.85, 1.35, 1.47),
@@ -100,7 +97,6 @@ def test_wrap_quality(dressed):
     assert np.isfinite(g.positions).all()
     assert r.penetration_count == 0 and r.penetration_deepest_mm <= 2.0
     assert r.seam_gap_mm <= 3.0
-    assert r.strain_mean < case.strain_mean
     assert r.strain_max < case.strain_max
     assert r.inverted_count == 0
     assert g.max_stroke_residual_m < case.residual_m
@@ -115,9 +111,15 @@ def test_garment_sits_where_it_should(dressed):
     assert lo_a < y.min() < lo_b and hi_a < y.max() < hi_b
 
 
-@pytest.mark.xfail(strict=True, reason="issue 3 targets not met: strain 1.1-1.5 % mean, 24-60 % max, residual 13-18 mm")
+def test_mean_strain_target(dressed):
+    """Issue 3's mean edge strain target, met since the wrap ends with edge-length restoration."""
+    _, g = dressed
+    assert g.report.strain_mean <= 0.01
+
+
+@pytest.mark.xfail(strict=True, reason="issue 3 targets not met: max strain 21-30 %, stroke residual 15-22 mm")
 def test_issue_targets(dressed):
     _, g = dressed
     r = g.report
-    assert r.strain_mean <= 0.01 and r.strain_max <= 0.05
+    assert r.strain_max <= 0.05
     assert g.max_stroke_residual_m <= 0.01
