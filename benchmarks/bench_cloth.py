@@ -30,6 +30,7 @@ from kitsuke.cloth import (
     locality_order,
     refine,
     relax,
+    restore_lengths,
     track,
 )
 from kitsuke.metrics import penetration, quality_report
@@ -81,6 +82,10 @@ def main() -> None:
     print(f"relax with collision (body + capsules)                       {ips:8.0f} it/s  ({1e3 / ips:.2f} ms)")
     ips0 = iterations_per_second(model, state, None)
     print(f"relax without collision                                      {ips0:8.0f} it/s  ({1e3 / ips0:.2f} ms)")
+    t = timeit(lambda: restore_lengths(model, state, None, sweeps=30), repeat=7) / 30
+    print(f"restore_lengths sweep (Gauss-Seidel over every edge)         {t * 1e3:8.2f} ms")
+    t = timeit(lambda: restore_lengths(model, state, collider, sweeps=30), repeat=7) / 30
+    print(f"restore_lengths sweep, collision every 3rd (the wrap's)      {t * 1e3:8.2f} ms")
     t = timeit(lambda: collide(model, state, collider), repeat=20)
     print(f"collide (capsules, tracking walk, push-out)                  {t * 1e3:8.2f} ms")
     t = timeit(lambda: track(model, state, collider), repeat=20)
