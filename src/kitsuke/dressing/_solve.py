@@ -235,7 +235,8 @@ def gravity_settle(
     obi band: a row of edges 8-30 % long), which the wrap's finish only partly takes back. Here the solve is
     stiff everywhere at once, so cloth that hangs swings down without stretching. Measured on the four shipped
     cases (mean edge strain, Jacobi -> global, see WrapParams.settle): shirt 1.43 -> 1.36 %, hoody 1.51 ->
-    1.40 %, T-shirt 1.08 -> 1.02 %, kimono 1.79 -> 1.19 %.
+    1.40 %, T-shirt 1.08 -> 1.02 %, kimono 1.79 -> 1.19 %; since the wrap ends with edge-length restoration
+    (`kitsuke.cloth.restore_lengths`), which takes that stretch out too, both settles end at the same strain.
     """
     solver = GlobalRelax(model, pinned, contact_weight=contact_weight, gravity_m=gravity_m, stick_weight=stick_weight)
     for _ in range(iterations):

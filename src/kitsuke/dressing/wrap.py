@@ -76,10 +76,11 @@ class WrapParams:
     settle : "jacobi" (default): `settle_iterations` of the paper's relaxation (`kitsuke.cloth.relax`) with
         gravity, friction and collision; "global": `settle_iterations` (30 is enough) global steps
         (`_solve.gravity_settle`) with gravity `settle_gravity_m` per step and static friction `stick_weight`.
-        The global settle does not stretch hanging cloth (mean strain, jacobi -> global: shirt 1.43 -> 1.36 %,
-        hoody 1.51 -> 1.39 %, T-shirt 1.08 -> 1.02 %, kimono 1.79 -> 1.19 %), costs ~0.1 s more on the shirt,
-        and rolling up a sleeve of the 3 cm kimono settled that way leaves one folded triangle that the drag's
-        untangle does not open (0 with the Jacobi settle); so it is not yet the default.
+        The global settle does not stretch hanging cloth (mean strain, jacobi -> global, before the finish and
+        the length restoration: shirt 2.6 -> 1.8 %; after them both end at 0.8 %), costs ~0.1-0.2 s more,
+        and one of the drag scenarios of tests/dressing/test_drag.py on the 3 cm kimono settled that way ends
+        with a folded triangle that the drag's untangle does not open (the sleeve roll-up before the length
+        restoration, the pins down the back after it; 0 with the Jacobi settle); so it is not yet the default.
     settle_iterations : iterations (jacobi) or steps (global) of the settle.
     settle_gravity_m : global settle: metres a free vertex falls per step.
     stick_weight : global settle: static friction (relative to one triangle edge); cloth touching the body when
