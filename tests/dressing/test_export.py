@@ -85,6 +85,10 @@ def test_dress_bad_input_is_exit_2_and_writes_nothing(run_cli, tmp_path):
         assert r.code == 2, (extra, r.err)
         assert needle in r.err and len(r.err.strip().splitlines()) == 1 and "Traceback" not in r.err
         assert not out.exists()
+    r = run_cli(
+        "dress", "--body", MEAN_ALL, "--garment", SHIRT, "--strokes", SHIRT_STROKES, "-o", out, "--hold-strokes"
+    )
+    assert r.code == 2 and "--hold-strokes is for a wrap" in r.err and not out.exists()
 
 
 def test_read_garment_obj_rejects_plain_meshes(tmp_path):

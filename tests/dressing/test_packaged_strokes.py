@@ -18,7 +18,7 @@ import pytest
 
 from kitsuke.body import default_body, load_body
 from kitsuke.dressing import check_strokes, load_packaged_strokes
-from kitsuke.dressing.wrap import DressedGarment, wrap
+from kitsuke.dressing.wrap import DressedGarment, WrapParams, wrap
 from kitsuke.pattern import load_pattern
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -123,3 +123,19 @@ def test_issue_targets(dressed):
     r = g.report
     assert r.strain_max <= 0.05
     assert g.max_stroke_residual_m <= 0.01
+
+
+def test_held_strokes_meet_the_residual_target():
+    """`WrapParams.strokes_held()`: the garment hangs from its strokes instead of settling away from them. On the
+    T-shirt both issue-3 targets it trades between are met (measured 2026-11-24: residual 6.5 mm, mean strain
+    0.77 %; 15 mm and 0.46 % with the free settle), and nothing else suffers."""
+    case = CASES["tshirt"]
+    g = wrap(
+        default_body(),
+        load_pattern(case.pattern),
+        load_packaged_strokes(case.strokes),
+        params=WrapParams.strokes_held(),
+    )
+    r = g.report
+    assert g.max_stroke_residual_m <= 0.01 and r.strain_mean <= 0.01
+    assert r.penetration_count == 0 and r.seam_gap_mm == 0.0 and r.inverted_count == 0

@@ -13,6 +13,9 @@ PATTERN is a kitsuke pattern JSON, a GarmentCode specification JSON or an SVG. S
 (SPEC 3.2): numbered pairs of a stroke on a pattern piece (cm) and a stroke on the body (points in metres, or laser
 rays). Stroke files ship with kitsuke for the examples below (see kitsuke/assets/strokes).
 
+By default the strokes place the garment and it then settles freely under gravity (the paper's way): it may slide
+a centimetre or two from where the strokes were drawn. --hold-strokes keeps it hanging from them instead.
+
 Outputs: OUT.glb for viewers (garment, double-sided, plus the body); --obj the checkable OBJ (v = world metres,
 vt = pattern metres, seam vertices shared, one `# kitsuke piece` line per piece); --report the quality report (JSON:
 penetration, strain, seam gap, inverted triangles, stroke residuals, timings); --png a front/side/back picture.
@@ -59,6 +62,12 @@ def register(parser: argparse.ArgumentParser) -> None:
         metavar="CM",
         help="target triangle edge length of the garment mesh, cm (default 1.5)",
     )
+    parser.add_argument(
+        "--hold-strokes",
+        action="store_true",
+        help="keep the garment where the strokes put it (it hangs from them) instead of letting it settle "
+        "freely: strokes met within millimetres, more strain where they ask for more than the pattern gives",
+    )
     add_body_options(parser)
     parser.set_defaults(run=run)
 
@@ -80,6 +89,8 @@ def run(args: argparse.Namespace) -> int:
     if not 0.2 <= args.edge_length <= 10:
         raise InputError(f"--edge-length must be between 0.2 and 10 cm, got {args.edge_length}")
     if args.garment:
+        if args.hold_strokes:
+            raise InputError("--hold-strokes is for a wrap: a re-wrap (--garment) holds its strokes already")
         return _rewrap(args, outs)
     if args.pin:
         raise InputError("--pin holds part of a dressed garment: use it with --garment (a re-wrap)")
@@ -88,7 +99,8 @@ def run(args: argparse.Namespace) -> int:
     strokes = read_strokes(args.strokes)
     check_strokes(strokes, pattern)
     body = body_from_args(args)
-    garment = wrap(body, pattern, strokes, params=WrapParams(edge_length_cm=args.edge_length))
+    make = WrapParams.strokes_held if args.hold_strokes else WrapParams
+    garment = wrap(body, pattern, strokes, params=make(edge_length_cm=args.edge_length))
     write_garment_glb(garment, outs[0], body=body.mesh)
     if args.obj:
         write_garment_obj(garment, args.obj)
