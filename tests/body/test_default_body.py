@@ -53,6 +53,21 @@ def test_weights_are_partition_of_unity_and_local(body):
     assert w[shin, INDEX["l_knee"]].mean() > 0.9
 
 
+def test_weight_of_a_bone_group(body):
+    """`Rig.weight_of` sums skin weights per vertex: all joints give 1; the torso's bones carry the belly at the
+    waist and not the hands hanging beside it."""
+    rig = body.rig
+    np.testing.assert_allclose(rig.weight_of(JOINTS), 1.0)
+    torso = rig.weight_of(("pelvis", "spine", "chest"))
+    v = body.mesh.vertices
+    waist = rig.joints[INDEX["spine"]]
+    belly = np.argmin(np.linalg.norm(v - (waist + [0.0, 0.0, 0.15]), axis=1))
+    hand = np.argmin(np.linalg.norm(v - rig.joints[INDEX["l_wrist"]], axis=1))
+    assert torso[belly] > 0.9 and torso[hand] < 0.05
+    with pytest.raises(ValueError):
+        rig.weight_of(("no_such_joint",))
+
+
 def test_bending_left_knee_moves_left_shin_only(body):
     posed = body.pose(rotations={"l_knee": [np.pi / 2, 0.0, 0.0]})
     v0, v1 = body.mesh.vertices, posed.vertices
