@@ -2,9 +2,9 @@
 every step; bad input.
 
 Two garments: a skirt (a tube sewn from a flat rectangle, hung round the hips with a little ease: exactly at rest,
-so every strain it shows comes from the drag) and the kimono as the wrap dresses it (`dress_default_kimono`, 3 cm
-triangles for speed). The wrap's kimono does not meet every quality target yet (its strain and inverted triangles
-come from the wrap), so on it the drag is held to "no worse than before".
+so every strain it shows comes from the drag) and the kimono exactly as `kitsuke demo` dresses it
+(`dress_default_kimono`, 1.5 cm triangles). The wrap's kimono meets every quality target of issue 3 but the max
+strain (70 % at a few sleeve-bag edges), so after each drag on it those targets are held and the max is not.
 """
 
 from __future__ import annotations
@@ -53,11 +53,8 @@ def skirt(body):
 
 
 @pytest.fixture(scope="module")
-def kimono(body):
-    from kitsuke.dressing import WrapParams
-    from kitsuke.dressing.kimono import dress_default_kimono
-
-    return dress_default_kimono(body, params=WrapParams(edge_length_cm=3.0))
+def kimono(dressed_kimono):
+    return dressed_kimono
 
 
 def piece_vertices(garment, name: str) -> np.ndarray:
@@ -75,14 +72,15 @@ def assert_quality_kept(before, after) -> None:
     assert after.strain_max <= max(0.05, before.strain_max + STRAIN_MARGIN)
 
 
-def assert_kimono_no_worse(before, after) -> None:
-    """The wrap's kimono misses the strain targets before any drag (~1.8 % mean, tens of % at a few hem and
-    sleeve edges), and a drag moving those parts moves their strained edges too. Held here: no penetration, no
-    folded triangle (the wrap and the release both untangle), seam gap <= 3 mm, mean strain no worse."""
-    assert after.penetration_count <= before.penetration_count
+def assert_kimono_targets_kept(before, after) -> None:
+    """The wrap's quality targets that the dressed kimono meets (issue 3; measured after each drag here: mean
+    strain 0.86-0.91 %, nothing inside the body, nothing folded): kept after a drag step. Its max strain (~70 % at
+    a few sleeve-bag edges before any drag) is not a target it meets, so it is not held."""
+    assert before.strain_mean <= 0.01 and before.inverted_count == 0 and before.penetration_count == 0
+    assert after.penetration_count == 0 and after.penetration_deepest_mm <= 2.0
     assert after.inverted_count == 0
     assert after.seam_gap_mm <= 3.0
-    assert after.strain_mean <= before.strain_mean + STRAIN_MARGIN
+    assert after.strain_mean <= 0.01
 
 
 def front_of(positions: np.ndarray, y: float) -> int:
@@ -122,7 +120,7 @@ def test_lift_the_kimono(body, kimono, collider):
     assert abs(np.median(dist) - 0.05) < 0.01
     assert np.mean(np.abs(dist - 0.05) <= 0.015) >= 0.9
     assert np.median(s.positions[:, 1] - x0[:, 1]) > 0.04
-    assert_kimono_no_worse(before, s.report())
+    assert_kimono_targets_kept(before, s.report())
 
 
 # -- (b) turn -----------------------------------------------------------------------------------------------------
@@ -180,7 +178,7 @@ def test_pins_down_the_back_stop_a_drag_of_the_front(body, kimono, collider):
     assert np.median(move[reached]) > 0.01
     # Attenuated towards the pins: cloth next to a pin barely moves.
     assert move[reached & (grab.distance_pin_m < 0.03)].max() < 0.5 * move[grab.vertex]
-    assert_kimono_no_worse(before, s.report())
+    assert_kimono_targets_kept(before, s.report())
 
 
 def test_a_pin_attenuates_the_drag_without_a_kink(body, skirt, collider):
@@ -232,7 +230,7 @@ def test_roll_up_a_kimono_sleeve(body, kimono, collider):
     near_shoulder = np.linalg.norm(x0 - shoulder, axis=1) < 0.1
     assert near_shoulder.sum() > 20 and np.abs(move[near_shoulder]).max() == 0.0
     assert np.median(move[sleeve[uv[sleeve, 0] > 25]] @ forearm) < -0.005  # the cuff's end of the sleeve bunches up
-    assert_kimono_no_worse(before, s.report())
+    assert_kimono_targets_kept(before, s.report())
 
 
 # -- API behaviour and bad input ----------------------------------------------------------------------------------

@@ -78,9 +78,9 @@ class WrapParams:
         (`_solve.gravity_settle`) with gravity `settle_gravity_m` per step and static friction `stick_weight`.
         The global settle does not stretch hanging cloth (mean strain, jacobi -> global, before the finish and
         the length restoration: shirt 2.6 -> 1.8 %; after them both end at 0.8 %), costs ~0.1-0.2 s more,
-        and one of the drag scenarios of tests/dressing/test_drag.py on the 3 cm kimono settled that way ends
-        with a folded triangle that the drag's untangle does not open (the sleeve roll-up before the length
-        restoration, the pins down the back after it; 0 with the Jacobi settle); so it is not yet the default.
+        and one of the drag scenarios of tests/dressing/test_drag.py on the kimono settled that way fails (the
+        lift, on the 1.5 cm kimono; on the 3 cm one before: a folded triangle the drag's untangle did not open);
+        so it is not the default.
     settle_iterations : iterations (jacobi) or steps (global) of the settle.
     settle_gravity_m : global settle: metres a free vertex falls per step.
     stick_weight : global settle: static friction (relative to one triangle edge); cloth touching the body when
