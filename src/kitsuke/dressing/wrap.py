@@ -19,8 +19,8 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
    Jacobi `relax` needs thousands) pulls them shut, the strokes only softly held (`stroke_hold`).
 4. **Settle**: relaxation with gravity and collision, the stroke pins released (or, `settle="global"`, global
    steps with gravity, the body contacts inside the solve and static friction: `_solve.gravity_settle`).
-   Optionally a band of the garment (e.g. where a kimono's obi goes) is held: its vertices are pinned where they
-   are after step 3.
+   Optionally a band of the garment (e.g. where a kimono's obi goes) is held: its vertices over the torso are
+   pinned where they are after step 3 (`_band_held`), for the settle only (the finish has no gravity).
 5. **Finish**: a few global relaxation steps without gravity take back the stretch the settle's gravity left in
    cloth resting on the body (`finish_iterations`); then Gauss-Seidel sweeps projecting each edge to its rest
    length take out the local strain that they leave (`length_sweeps`, `kitsuke.cloth.restore_lengths`).
