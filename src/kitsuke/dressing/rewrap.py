@@ -27,7 +27,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, collide, relax, restore_lengths, untangle
+from ..cloth import (
+    BodyCollider,
+    ClothModel,
+    ClothParams,
+    ClothState,
+    collide,
+    folded_faces,
+    relax,
+    restore_lengths,
+    untangle,
+)
 from ..errors import InputError
 from ..geometry import TriMesh
 from ..geometry.surface import Surface
@@ -254,6 +264,14 @@ def rewrap(
         restore_lengths(model, state, collider, sweeps=p.length_sweeps)
     if p.untangle_rounds:
         untangle(model, state, collider, rounds=p.untangle_rounds)
+        folded = folded_faces(model, state)
+        if folded.any():
+            # A triangle folded against the held stroke row cannot open while the row holds it (the 1.5 cm kimono,
+            # hem turned up: 2 left folded): let go of the stroke vertices of the folded triangles only, and retry.
+            loose = np.zeros(model.n_vertices, dtype=bool)
+            loose[model.faces[folded].reshape(-1)] = True
+            state.pinned = state.pinned & ~(loose & ~pinned)
+            untangle(model, state, collider, rounds=p.untangle_rounds)
     state.positions[pinned] = g.positions[pinned]  # exactly still
     timings["relax"] = time.perf_counter() - t2
     timings["rewrap"] = time.perf_counter() - t0
