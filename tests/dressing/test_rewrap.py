@@ -10,7 +10,7 @@ import pytest
 from kitsuke.dressing import BodyStroke, PatternStroke, StrokePair, Strokes, write_strokes
 from kitsuke.dressing._place import locate_in_triangles
 from kitsuke.dressing.export import as_garment_file, read_garment_obj, write_garment_obj
-from kitsuke.dressing.rewrap import rewrap
+from kitsuke.dressing.rewrap import RewrapParams, rewrap
 from kitsuke.errors import InputError
 
 LIFT_M = 0.04
@@ -93,6 +93,8 @@ def test_rewrap_bad_input(body, dressed):
     far = Strokes([StrokePair(1, s.pairs[0].pattern, BodyStroke(points=[[0, 3.0, 0], [0, 3.1, 0]]))], target="garment")
     with pytest.raises(InputError, match="from the garment surface"):
         rewrap(body, dressed, far)
+    with pytest.raises(InputError, match="length_sweeps"):
+        RewrapParams(length_sweeps=-1)
 
 
 def test_cli_rewrap_writes_obj_and_report_and_refuses_bad_pins(run_cli, tmp_path, body, dressed):

@@ -285,6 +285,12 @@ def test_wrap_rejects_a_missing_piece_and_bad_params():
         WrapParams(settle="verlet")
     with pytest.raises(InputError, match="stick_weight"):
         WrapParams(stick_weight=-1.0)
+    with pytest.raises(InputError, match="length_sweeps"):
+        WrapParams(length_sweeps=-1)
+    with pytest.raises(InputError, match="hold_reach_m"):
+        WrapParams(hold_reach_m=0.0)
+    with pytest.raises(InputError, match="hold_reach_m"):
+        WrapParams.strokes_held(hold_reach_m=float("nan"))
     with pytest.raises(InputError, match="no strokes"):
         wrap(_sphere(), _square(), Strokes([]))
     garment_target = Strokes(_sheet_strokes(0.3).pairs, target="garment")

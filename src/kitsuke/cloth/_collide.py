@@ -191,15 +191,23 @@ def _buffers(state: ClothState) -> dict:
     return w
 
 
-def active_edges(model: ClothModel, state: ClothState) -> np.ndarray:
-    """(E', 2) int64 edges of the active triangles (cached on the state while face_active is unchanged)."""
+def active_edge_index(model: ClothModel, state: ClothState) -> np.ndarray:
+    """(E',) int64 indices into model.edges of the edges of the active triangles (cached on the state while
+    face_active is unchanged)."""
     w = state._work
     key = state.face_active.tobytes()
     if w.get("active_edges_key") != key:
         ef = model.edge_faces
         on = state.face_active[ef[:, 0]] | ((ef[:, 1] >= 0) & state.face_active[np.maximum(ef[:, 1], 0)])
-        w["active_edges"], w["active_edges_key"] = np.ascontiguousarray(model.edges[on]), key
-    return w["active_edges"]
+        index = np.flatnonzero(on)
+        w["active_edge_index"], w["active_edges"], w["active_edges_key"] = index, model.edges[index], key
+    return w["active_edge_index"]
+
+
+def active_edges(model: ClothModel, state: ClothState) -> np.ndarray:
+    """(E', 2) int64 edges of the active triangles (cached like `active_edge_index`)."""
+    active_edge_index(model, state)
+    return state._work["active_edges"]
 
 
 def vertex_active(model: ClothModel, state: ClothState) -> np.ndarray:

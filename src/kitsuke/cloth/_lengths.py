@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import InputError
 from . import _kernels as K
-from ._collide import BodyCollider, collide, vertex_active
+from ._collide import BodyCollider, active_edge_index, collide, vertex_active
 from ._model import ClothModel, ClothState
 
 
@@ -58,9 +58,7 @@ def restore_lengths(
         raise InputError("restore_lengths needs sweeps >= 0, collide_every >= 1 and tolerance_m >= 0")
     if collider is not None and not isinstance(collider, BodyCollider):
         raise InputError("collider must be a BodyCollider or None")
-    ef = model.edge_faces
-    on = state.face_active[ef[:, 0]] | ((ef[:, 1] >= 0) & state.face_active[np.maximum(ef[:, 1], 0)])
-    forward = np.flatnonzero(on)
+    forward = active_edge_index(model, state)
     backward = np.ascontiguousarray(forward[::-1])
     movable = vertex_active(model, state) & ~state.pinned
     stats = LengthStats()

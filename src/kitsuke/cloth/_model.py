@@ -330,9 +330,8 @@ class Contacts:
         follows the distance downhill from the last face, so where two body surfaces are close (an armpit: arm
         and torso) a vertex pushed through one of them can stay tracked to the other, outside it; a global search
         finds the true nearest point (measured on GarmentCode's shirt after the wrap's close: 9 vertices 2-4 mm
-        inside the torso, all tracked to the arm; after `forget` and one collision update, none). Not yet called
-        by the wrap: refreshing there changed the 3 cm kimono enough that the sleeve roll-up and the hem re-wrap
-        each left one folded triangle."""
+        inside the torso, all tracked to the arm; after `forget` and one collision update, none). The wrap calls
+        it before its edge-length restoration and the global settle at its end."""
         self.face[:] = -1
         self.distance[:] = np.inf
         self.anchor_distance[:] = np.inf
