@@ -195,3 +195,30 @@ def project_lengths(pos, edges, rest, movable, order):
         pos[a] += w[0] * corr
         pos[b] -= w[1] * corr
     return pos, worst
+
+
+def project_tethers(pos, tri, bary, movable, lines, line_of, reach):
+    """One sweep of tethers: each cloth point (barycentric in its triangle) farther than `reach` from its polyline
+    (lines[line_of[i]], (k, 3)) is moved towards the polyline's nearest point until it is `reach` away, its
+    vertices sharing the move in proportion to their barycentric weight; a point with a fixed vertex stays."""
+    pos = pos.copy()
+    worst = 0.0
+    for i in range(len(tri)):
+        if not movable[tri[i]].all():
+            continue
+        p = bary[i] @ pos[tri[i]]
+        line = lines[line_of[i]]
+        best, q = np.inf, None
+        for a, b in zip(line[:-1], line[1:], strict=True):
+            e = b - a
+            t = 0.0 if e @ e <= 1e-24 else float(np.clip((p - a) @ e / (e @ e), 0.0, 1.0))
+            c = a + t * e
+            if np.linalg.norm(p - c) < best:
+                best, q = np.linalg.norm(p - c), c
+        over = best - reach
+        if over <= 0:
+            continue
+        worst = max(worst, over)
+        for k in range(3):
+            pos[tri[i, k]] += bary[i, k] / (bary[i] @ bary[i]) * over / best * (q - p)
+    return pos, worst

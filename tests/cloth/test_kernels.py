@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kitsuke.cloth import ClothParams
+from kitsuke.cloth import ClothParams, Tethers
 from kitsuke.cloth import _kernels as K
 
 from . import reference as ref
@@ -177,3 +177,33 @@ def test_project_lengths_matches_reference_and_keeps_fixed_vertices(crumpled, rn
     if movable[model.edges[last]].any():
         a, b = model.edges[last]
         assert np.linalg.norm(got[b] - got[a]) == pytest.approx(model.rest_lengths[last])
+
+
+def test_project_tethers_matches_reference_and_moves_only_what_is_out_of_reach(crumpled, rng):
+    """Points on random triangles tethered to two random polylines: the kernel moves what the numpy reference
+    moves, leaves fixed vertices and points already within reach alone, and puts the rest exactly at reach."""
+    model, pos = crumpled
+    n = 40
+    faces = rng.integers(0, model.n_faces, n)
+    bary = rng.dirichlet(np.ones(3), n)
+    lines = [pos.mean(axis=0) + rng.normal(0.0, 0.03, (6, 3)), pos.mean(axis=0) + rng.normal(0.0, 0.03, (4, 3))]
+    tethers = Tethers.from_polylines(
+        [(faces[:25], bary[:25], lines[0]), (faces[25:], bary[25:], lines[1])], model.faces, reach_m=0.02
+    )
+    movable = rng.random(model.n_vertices) > 0.2
+    movable[tethers.tri[-1]] = True
+    got = pos.copy()
+    worst = K.project_tethers(
+        got, tethers.tri, tethers.bary, movable, tethers.line_points, tethers.line_start, tethers.line_of, 0.02
+    )
+    expect, expect_worst = ref.project_tethers(pos, tethers.tri, tethers.bary, movable, lines, tethers.line_of, 0.02)
+    np.testing.assert_allclose(got, expect, atol=ATOL)
+    assert worst == pytest.approx(expect_worst) and worst > 0
+    np.testing.assert_array_equal(got[~movable], pos[~movable])
+    untouched = np.setdiff1d(np.arange(model.n_vertices), tethers.tri.reshape(-1))
+    np.testing.assert_array_equal(got[untouched], pos[untouched])
+    # The sweep's last point (no later one moves its vertices) ends within reach.
+    p = tethers.bary[-1] @ got[tethers.tri[-1]]
+    a, b = lines[1][:-1], lines[1][1:]
+    t = np.clip(np.einsum("ij,ij->i", p - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0, 1)
+    assert np.linalg.norm(p - (a + t[:, None] * (b - a)), axis=1).min() <= 0.02 + 1e-9

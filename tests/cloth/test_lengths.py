@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kitsuke.cloth import ClothState, restore_lengths
+from kitsuke.cloth import ClothState, Tethers, restore_lengths
 from kitsuke.errors import InputError
 from kitsuke.metrics import penetration, strain
 
@@ -61,6 +61,56 @@ def test_a_sheet_stretched_over_a_sphere_shrinks_and_keeps_out_of_it(sphere, sph
     np.testing.assert_array_equal(state.positions[centre], pos[centre])
 
 
+def line_distance(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(n,) distance of points (n, 3) to the segment a-b."""
+    t = np.clip((points - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0)
+    return np.linalg.norm(points - (a + t[:, None] * (b - a)), axis=1)
+
+
+def right_edge_tethers(model, rest, line: np.ndarray, reach_m: float) -> tuple[Tethers, np.ndarray]:
+    """Tethers on the centres of the triangles touching the sheet's right column, to `line` (2, 3); and the
+    triangles' vertex indices (n, 3)."""
+    right = np.flatnonzero(np.isclose(rest[:, 0], rest[:, 0].max()))
+    faces = np.flatnonzero(np.isin(model.faces, right).any(axis=1))
+    bary = np.full((len(faces), 3), 1.0 / 3.0)
+    return Tethers.from_polylines([(faces, bary, line)], model.faces, reach_m), model.faces[faces]
+
+
+def test_tethers_lift_the_free_edge_to_its_line_without_stretching_the_sheet():
+    """The left column pinned, the right edge tethered (5 mm reach) to a line 5 cm up, where the edge comes when
+    the sheet turns about its pins (a turn costs no edge length): every tethered point ends within reach, and
+    the sheet keeps its rest lengths."""
+    model, rest = flat_sheet(12, 10, 0.02, gravity_step_m=0.0)
+    r, y1 = rest[:, 0].max() - 0.01, rest[:, 1].max()  # the tethered triangle centres lie 0.3-0.7 cm in
+    x = np.sqrt(r**2 - 0.05**2)
+    line = np.array([[x, 0.0, 0.05], [x, y1, 0.05]])
+    tethers, tri = right_edge_tethers(model, rest, line, 0.005)
+    pins = rest[:, 0] == 0.0
+    state = ClothState.new(model, rest.copy(), pinned=pins)
+    stats = restore_lengths(model, state, sweeps=600, tethers=tethers)
+    points = np.einsum("ij,ijk->ik", tethers.bary, state.positions[tri])
+    assert line_distance(points, *line).max() <= 0.005 + 2e-4
+    assert stats.worst_tether_m < 2e-4
+    assert strain(state.positions, model.edges, model.rest_lengths).max < 0.02
+    np.testing.assert_array_equal(state.positions[pins], rest[pins])
+    assert state.positions[:, 2].max() > 0.04  # it did lift
+
+
+def test_tethers_within_reach_change_nothing():
+    """A one-sided constraint: a stretched sheet whose tethered points stay within reach of their line all along
+    ends bit-identical to the same restoration without tethers."""
+    model, rest = flat_sheet(8, 6, 0.02, gravity_step_m=0.0)
+    stretched = rest * [1.1, 1.0, 1.0]
+    x1, y1 = stretched[:, 0].max(), stretched[:, 1].max()
+    tethers, _ = right_edge_tethers(model, rest, np.array([[x1, 0.0, 0.0], [x1, y1, 0.0]]), 0.5)
+    pins = rest[:, 0] == 0.0
+    free, held = ClothState.new(model, stretched, pinned=pins), ClothState.new(model, stretched, pinned=pins)
+    restore_lengths(model, free, sweeps=50)
+    stats = restore_lengths(model, held, sweeps=50, tethers=tethers)
+    np.testing.assert_array_equal(held.positions, free.positions)
+    assert stats.worst_tether_m == 0.0
+
+
 def test_bad_arguments_are_rejected():
     model, rest = flat_sheet(4, 4, 0.02)
     state = ClothState.new(model, rest)
@@ -69,3 +119,11 @@ def test_bad_arguments_are_rejected():
             restore_lengths(model, state, **kw)
     with pytest.raises(InputError):
         restore_lengths(model, rest)
+    with pytest.raises(InputError, match="tethers must be"):
+        restore_lengths(model, state, tethers="strokes")
+    line = np.zeros((2, 3))
+    other, _ = flat_sheet(8, 8, 0.02)
+    with pytest.raises(InputError, match="vertices the model does not have"):
+        restore_lengths(model, state, tethers=Tethers.from_polylines([([60], [[1, 0, 0]], line)], other.faces, 0.01))
+    with pytest.raises(InputError, match="reach"):
+        Tethers.from_polylines([([0], [[1, 0, 0]], line)], model.faces, 0.0)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kitsuke.cloth import ClothState, folded_faces, untangle
+from kitsuke.cloth import ClothState, Tethers, folded_faces, untangle
 from kitsuke.errors import InputError
 from kitsuke.metrics import inverted_triangles, strain
 
@@ -51,6 +51,26 @@ def test_pinned_vertices_never_move_and_nothing_happens_without_folds():
     flat = ClothState.new(model, rest)
     stats = untangle(model, flat)
     assert stats.rounds == 0 and stats.before == 0 and (flat.positions == rest).all()
+
+
+def test_tethers_hold_inside_the_untangled_region():
+    """A point on the cloth next to the fold, tethered (2 mm reach) to a line 1 cm above where it lies: the fold
+    opens, the point ends within reach of its line, and the cloth outside the region still does not move."""
+    model, folded, rest = folded_sheet()
+    state = ClothState.new(model, folded)
+    fold = np.flatnonzero(folded_faces(model, state))
+    ring = np.flatnonzero(np.isin(model.faces, model.faces[fold]).any(axis=1))
+    face = int(np.setdiff1d(ring, fold)[0])
+    p0 = folded[model.faces[face]].mean(axis=0)
+    line = np.array([p0 + [-0.02, 0, 0.01], p0 + [0.02, 0, 0.01]])
+    tethers = Tethers.from_polylines([([face], [[1 / 3, 1 / 3, 1 / 3]], line)], model.faces, 0.002)
+    stats = untangle(model, state, rings=3, tethers=tethers)
+    assert stats.after == 0
+    p = state.positions[model.faces[face]].mean(axis=0)
+    assert abs(p[0] - p0[0]) < 0.02  # within the line's ends, which run along x: its distance is in y and z
+    assert np.linalg.norm(p[1:] - line[0, 1:]) <= 0.002 + 1e-9
+    moved = np.linalg.norm(state.positions - folded, axis=1) > 0
+    assert moved.sum() <= stats.moved and (~moved).sum() > 100
 
 
 def test_untangle_rejects_bad_arguments():

@@ -278,5 +278,7 @@ def test_bad_input_raises_and_leaves_the_garment_unchanged(body, skirt, collider
         DragParams(near_m=0.05, far_m=0.01)
     with pytest.raises(InputError, match="release_untangle_rounds"):
         DragParams(release_untangle_rounds=-1)
+    with pytest.raises(InputError, match="release_untangle_iterations"):
+        DragParams(release_untangle_iterations=0)
     with pytest.raises(InputError):
         DragSession(body, "not a garment")

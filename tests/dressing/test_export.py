@@ -62,6 +62,8 @@ def test_report_glb_and_png(dressed):
     q = report["quality"]
     assert q["penetration_count"] == 0 and q["seam_gap_mm"] == 0.0
     assert report["vertices"] == len(read_garment_obj(dressed["obj"]).positions)
+    # The command's default tethers keep every stroke within 8 mm of where it was drawn (1 cm is the target).
+    assert len(report["strokes"]) == 8 and max(s["residual_mm"] for s in report["strokes"]) <= 10.0
     glb = load_mesh(dressed["glb"])  # garment + body in one scene
     assert glb.n_faces == len(read_garment_obj(dressed["obj"]).faces) + load_mesh(MEAN_ALL).n_faces
     img = np.asarray(Image.open(dressed["png"]).convert("RGB")).astype(int)
@@ -79,6 +81,7 @@ def test_dress_bad_input_is_exit_2_and_writes_nothing(run_cli, tmp_path):
         (["--strokes", str(bad)], "no_such_piece"),
         (["--strokes", str(tmp_path / "missing.json")], "missing.json"),
         (["--strokes", str(SHIRT_STROKES), "--obj", str(SHIRT)], "must end in .obj"),
+        (["--strokes", str(SHIRT_STROKES), "--stroke-reach", "-1"], "--stroke-reach must be between 0 and 100 mm"),
     ]
     for extra, needle in cases:
         r = run_cli("dress", "--body", MEAN_ALL, "--pattern", SHIRT, "-o", out, *extra)
@@ -89,6 +92,10 @@ def test_dress_bad_input_is_exit_2_and_writes_nothing(run_cli, tmp_path):
         "dress", "--body", MEAN_ALL, "--garment", SHIRT, "--strokes", SHIRT_STROKES, "-o", out, "--hold-strokes"
     )
     assert r.code == 2 and "--hold-strokes is for a wrap" in r.err and not out.exists()
+    r = run_cli(
+        "dress", "--body", MEAN_ALL, "--garment", SHIRT, "--strokes", SHIRT_STROKES, "-o", out, "--stroke-reach", "5"
+    )
+    assert r.code == 2 and "--stroke-reach is for a wrap" in r.err and not out.exists()
 
 
 def test_read_garment_obj_rejects_plain_meshes(tmp_path):

@@ -3,10 +3,10 @@ GarmentCode's shirt and hoody on mean_all, the FreeSewing T-shirt (sewn by tools
 default body (the kimono on the default body, with its obi band, is in test_wrap.py). Each case asserts its
 measured quality (SPEC §6) with a small margin, so a change that makes a shipped case worse fails here.
 
-Issue 3's targets: penetration (none deeper than 2 mm), seam gap (≤ 3 mm), no inverted triangle and mean strain
-(≤ 1 %) are met and asserted for every case; max strain (≤ 5 %) and stroke residual (≤ 10 mm) are NOT met by any
-case: `test_issue_targets` states them as a strict expected failure, so the day they are met the suite says so
-(and the marker must go)."""
+Issue 3's targets: penetration (none deeper than 2 mm), seam gap (≤ 3 mm), no inverted triangle, mean strain
+(≤ 1 %) and stroke residual (≤ 10 mm, since the wrap tethers its strokes) are met and asserted for every case; max
+strain (≤ 5 %) is NOT met by any case: `test_issue_targets` states it as a strict expected failure, so the day it
+is met the suite says so (and the marker must go)."""
 
 from __future__ import annotations
 
@@ -34,41 +34,36 @@ class Case:
     pattern: Path
     body: Path | None  # None: the default body
     strain_max: float
-    residual_m: float
     y_range: tuple[float, float, float, float]  # garment lowest y in [a, b], highest y in [c, d] (metres)
 
 
 CASES = {
-    # measured 2026-11-24: strain 0.81 % / 30 %, 0 inverted, residual 21 mm, deepest 1.7 mm, y 1.02 .. 1.45 m
-    # (before the length restoration: 1.43 % / 33 %, 18 mm; before the finish step: 2.13 % / 44 %)
+    # measured 2026-11-24: strain 0.87 % / 30 %, 0 inverted, residual 8.6 mm (21 mm without the stroke tethers),
+    # deepest 1.0 mm (before the length restoration: 1.43 % / 33 %, 18 mm; before the finish step: 2.13 % / 44 %)
     "shirt": Case(
         "shirt_mean_all",
         DATA / "pattern" / "shirt_mean_specification.json",
         DATA / "bodies" / "mean_all.obj",
         0.45,
-        0.025,
         (0.95, 1.10, 1.38, 1.50),
     ),
-    # measured 2026-11-24: strain 0.94 % / 21 % (the max is where the hood meets the neckline; before the length
-    # restoration 1.41-1.56 % / 30-59 %, moving with the installed libraries' versions), 0 inverted, residual
-    # 22 mm, y 0.99 .. 1.72 m (the hood reaches over the top of the head)
+    # measured 2026-11-24: strain 0.87 % / 29 % (before the length restoration 1.41-1.56 % / 30-59 %, moving
+    # with the installed libraries' versions), 0 inverted, residual 8.4 mm (22 mm without the stroke tethers: the
+    # hood hangs behind the head), the hood reaching over the top of the head
     "hoody": Case(
         "hoody_mean_all",
         DATA / "pattern" / "hoody_mean_specification.json",
         DATA / "bodies" / "mean_all.obj",
         0.5,
-        0.025,
         (0.92, 1.10, 1.66, 1.78),
     ),
-    # measured 2026-11-24: strain 0.46 % / 24 %, 0 inverted, residual 15 mm (before the length restoration:
-    # 1.08 %, 8-13 mm), no vertex inside, y 0.73 .. 1.41 m (cut for a 110 cm chest on an 84 cm one: it hangs
-    # loose to the thighs)
+    # measured 2026-11-24: strain 0.46 % / 26 %, 0 inverted, residual 8.2 mm (15 mm without the stroke tethers),
+    # no vertex inside (cut for a 110 cm chest on an 84 cm one: it hangs loose to the thighs)
     "tshirt": Case(
         "tshirt_default",
         DATA / "pattern" / "teagan_tshirt_cisMaleAdult42_sewn.json",
         None,
         0.4,
-        0.02,
         (0.65, 0.85, 1.35, 1.47),
     ),
 }
@@ -99,7 +94,6 @@ def test_wrap_quality(dressed):
     assert r.seam_gap_mm <= 3.0
     assert r.strain_max < case.strain_max
     assert r.inverted_count == 0
-    assert g.max_stroke_residual_m < case.residual_m
     np.testing.assert_allclose(g.stroke_length_ratio, 1.0, atol=0.01)
 
 
@@ -117,18 +111,38 @@ def test_mean_strain_target(dressed):
     assert g.report.strain_mean <= 0.01
 
 
-@pytest.mark.xfail(strict=True, reason="issue 3 targets not met: max strain 21-30 %, stroke residual 15-22 mm")
+def test_stroke_residual_target(dressed):
+    """Issue 3: every pattern stroke lies within 1 cm of its body stroke after wrap and settle (the wrap's
+    tethers hold them within 8 mm; measured 8.2-8.6 mm, the samples between vertices a little farther)."""
+    _, g = dressed
+    assert g.max_stroke_residual_m <= 0.01
+    assert len(g.stroke_residual_m) == len(g.stroke_ids) >= 4
+
+
+def test_without_tethers_the_garment_settles_away_from_its_strokes():
+    """What the tethers are for: the T-shirt wrapped with `stroke_reach_m=None` rests where gravity and its ease
+    put it, its strokes farther than 1 cm from where they were drawn (measured 2026-11-24: 14.9 mm)."""
+    case = CASES["tshirt"]
+    g = wrap(
+        default_body(),
+        load_pattern(case.pattern),
+        load_packaged_strokes(case.strokes),
+        params=WrapParams(stroke_reach_m=None),
+    )
+    assert g.max_stroke_residual_m > 0.012
+    assert g.report.penetration_count == 0 and g.report.inverted_count == 0
+
+
+@pytest.mark.xfail(strict=True, reason="issue 3 target not met: max strain 26-30 % (vertices with > 360° of pattern)")
 def test_issue_targets(dressed):
     _, g = dressed
-    r = g.report
-    assert r.strain_max <= 0.05
-    assert g.max_stroke_residual_m <= 0.01
+    assert g.report.strain_max <= 0.05
 
 
 def test_held_strokes_meet_the_residual_target():
     """`WrapParams.strokes_held()`: the garment hangs from its strokes instead of settling away from them. On the
-    T-shirt both issue-3 targets it trades between are met (measured 2026-11-24: residual 6.5 mm, mean strain
-    0.77 %; 15 mm and 0.46 % with the free settle), and nothing else suffers."""
+    T-shirt the residual and mean strain targets are met (measured 2026-11-24: residual 6.5 mm, mean strain
+    0.77 %; 8.2 mm and 0.46 % with the default tethers), and nothing else suffers."""
     case = CASES["tshirt"]
     g = wrap(
         default_body(),

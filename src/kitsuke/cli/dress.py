@@ -13,8 +13,9 @@ PATTERN is a kitsuke pattern JSON, a GarmentCode specification JSON or an SVG. S
 (SPEC 3.2): numbered pairs of a stroke on a pattern piece (cm) and a stroke on the body (points in metres, or laser
 rays). Stroke files ship with kitsuke for the examples below (see kitsuke/assets/strokes).
 
-By default the strokes place the garment and it then settles freely under gravity (the paper's way): it may slide
-a centimetre or two from where the strokes were drawn. --hold-strokes keeps it hanging from them instead.
+By default the strokes place the garment and it then settles under gravity (the paper's way), each pattern
+stroke kept within 8 mm of its body stroke (--stroke-reach; 0 lets it settle freely, a centimetre or two away).
+--hold-strokes keeps the garment hanging from the strokes exactly instead.
 
 Outputs: OUT.glb for viewers (garment, double-sided, plus the body); --obj the checkable OBJ (v = world metres,
 vt = pattern metres, seam vertices shared, one `# kitsuke piece` line per piece); --report the quality report (JSON:
@@ -68,6 +69,13 @@ def register(parser: argparse.ArgumentParser) -> None:
         help="keep the garment where the strokes put it (it hangs from them) instead of letting it settle "
         "freely: strokes met within millimetres, more strain where they ask for more than the pattern gives",
     )
+    parser.add_argument(
+        "--stroke-reach",
+        type=float,
+        default=8.0,
+        metavar="MM",
+        help="how far a pattern stroke may settle from its body stroke, mm (default 8; 0: settle freely)",
+    )
     add_body_options(parser)
     parser.set_defaults(run=run)
 
@@ -88,7 +96,11 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("the output files must be different")
     if not 0.2 <= args.edge_length <= 10:
         raise InputError(f"--edge-length must be between 0.2 and 10 cm, got {args.edge_length}")
+    if not 0 <= args.stroke_reach <= 100:
+        raise InputError(f"--stroke-reach must be between 0 and 100 mm, got {args.stroke_reach}")
     if args.garment:
+        if args.stroke_reach != 8.0:
+            raise InputError("--stroke-reach is for a wrap: a re-wrap (--garment) holds its strokes already")
         if args.hold_strokes:
             raise InputError("--hold-strokes is for a wrap: a re-wrap (--garment) holds its strokes already")
         return _rewrap(args, outs)
@@ -100,7 +112,8 @@ def run(args: argparse.Namespace) -> int:
     check_strokes(strokes, pattern)
     body = body_from_args(args)
     make = WrapParams.strokes_held if args.hold_strokes else WrapParams
-    garment = wrap(body, pattern, strokes, params=make(edge_length_cm=args.edge_length))
+    reach = args.stroke_reach * 1e-3 if args.stroke_reach > 0 else None
+    garment = wrap(body, pattern, strokes, params=make(edge_length_cm=args.edge_length, stroke_reach_m=reach))
     write_garment_glb(garment, outs[0], body=body.mesh)
     if args.obj:
         write_garment_obj(garment, args.obj)

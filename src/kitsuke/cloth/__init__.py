@@ -18,6 +18,7 @@ from ._model import ClothModel, ClothParams, ClothState, Contacts, locality_orde
 from ._relax import RelaxStats, relax
 from ._shapes import grid_sheet, grid_tube, hugging_tube, triangle_frames
 from ._subdivide import Refinement, colliding_edges, refine, sqrt3_split
+from ._tethers import Tethers
 from ._untangle import UntangleStats, folded_faces, untangle
 
 __all__ = [
@@ -30,6 +31,7 @@ __all__ = [
     "LengthStats",
     "Refinement",
     "RelaxStats",
+    "Tethers",
     "UntangleStats",
     "collide",
     "folded_faces",

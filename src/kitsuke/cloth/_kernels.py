@@ -362,6 +362,56 @@ def project_lengths(pos, edges, rest_lengths, movable, order):
     return worst
 
 
+@njit(cache=True)
+def project_tethers(pos, tri, bary, movable, line_points, line_start, line_of, reach):
+    """One sweep of tethers (in place on pos (V, 3)): each cloth point p = sum_k bary[i, k] * pos[tri[i, k]]
+    farther than `reach` metres from its polyline (points line_points[line_start[l]:line_start[l + 1]], l =
+    line_of[i]) is pulled straight towards the polyline's nearest point until it is `reach` away, its vertices
+    moving in proportion to their barycentric weight (the least-norm move that does it). A point with a vertex
+    that may not move is left to it: moving only the others could take a vertex of small weight far (by the
+    distance over its weight). Returns the largest distance beyond `reach` met in the sweep, metres (before the
+    correction), over the points it may move.
+    """
+    worst = 0.0
+    for i in range(tri.shape[0]):
+        if not (movable[tri[i, 0]] and movable[tri[i, 1]] and movable[tri[i, 2]]):
+            continue
+        px = py = pz = 0.0
+        for k in range(3):
+            v = tri[i, k]
+            px += bary[i, k] * pos[v, 0]
+            py += bary[i, k] * pos[v, 1]
+            pz += bary[i, k] * pos[v, 2]
+        l = line_of[i]
+        best = math.inf
+        qx = qy = qz = 0.0
+        for j in range(line_start[l], line_start[l + 1] - 1):
+            ax, ay, az = line_points[j, 0], line_points[j, 1], line_points[j, 2]
+            ex, ey, ez = line_points[j + 1, 0] - ax, line_points[j + 1, 1] - ay, line_points[j + 1, 2] - az
+            ee = ex * ex + ey * ey + ez * ez
+            t = 0.0
+            if ee > TINY2:
+                t = min(1.0, max(0.0, ((px - ax) * ex + (py - ay) * ey + (pz - az) * ez) / ee))
+            cx, cy, cz = ax + t * ex, ay + t * ey, az + t * ez
+            d2 = (px - cx) ** 2 + (py - cy) ** 2 + (pz - cz) ** 2
+            if d2 < best:
+                best, qx, qy, qz = d2, cx, cy, cz
+        d = math.sqrt(best)
+        over = d - reach
+        if over <= 0.0:
+            continue
+        worst = max(worst, over)
+        w2 = bary[i, 0] * bary[i, 0] + bary[i, 1] * bary[i, 1] + bary[i, 2] * bary[i, 2]
+        f = over / (d * w2)
+        for k in range(3):
+            v = tri[i, k]
+            s = f * bary[i, k]
+            pos[v, 0] += s * (qx - px)
+            pos[v, 1] += s * (qy - py)
+            pos[v, 2] += s * (qz - pz)
+    return worst
+
+
 def set_parallel(parallel: bool) -> None:
     """Recompile the per-element kernels with or without threads (for benchmarks; not cached)."""
     g = globals()

@@ -18,6 +18,7 @@ from ..errors import InputError
 from . import _kernels as K
 from ._collide import BodyCollider, active_edge_index, collide, vertex_active
 from ._model import ClothModel, ClothState
+from ._tethers import Tethers
 
 
 @dataclass
@@ -25,11 +26,13 @@ class LengthStats:
     """What `restore_lengths` did.
 
     sweeps : sweeps run. worst_error_m : the largest edge length error met in the last sweep, metres.
-    searches : global nearest-point searches of the collision updates.
+    searches : global nearest-point searches of the collision updates. worst_tether_m : the farthest a tethered
+    point was beyond its reach in the last sweep, metres.
     """
 
     sweeps: int = 0
     worst_error_m: float = 0.0
+    worst_tether_m: float = 0.0
     searches: int = 0
 
 
@@ -41,6 +44,7 @@ def restore_lengths(
     sweeps: int = 300,
     collide_every: int = 3,
     tolerance_m: float = 0.0,
+    tethers: Tethers | None = None,
 ) -> LengthStats:
     """Pull every edge of the active triangles towards its rest length (in place on `state`).
 
@@ -48,7 +52,10 @@ def restore_lengths(
         the cloth towards where the sweep ends). collide_every : a collision update after this many sweeps and
         after the last (the projection moves vertices by at most a few millimetres per sweep, so collision need
         not follow each one; measured on the shirt: every sweep or every third, the same strain).
-    tolerance_m : stop once no edge is further than this from its rest length, metres (0: run every sweep).
+    tolerance_m : stop once no edge is further than this from its rest length and no tethered point further than
+        this beyond its reach, metres (0: stop only at a sweep that found nothing to correct).
+    tethers : cloth points kept within a reach of polylines, projected after the edges in every sweep, so the
+        edges settle around them (the wrap keeps its pattern strokes near their body strokes this way).
     Pinned vertices, and vertices of no active triangle, do not move.
     """
     if not isinstance(state, ClothState):
@@ -58,6 +65,10 @@ def restore_lengths(
         raise InputError("restore_lengths needs sweeps >= 0, collide_every >= 1 and tolerance_m >= 0")
     if collider is not None and not isinstance(collider, BodyCollider):
         raise InputError("collider must be a BodyCollider or None")
+    if tethers is not None and not isinstance(tethers, Tethers):
+        raise InputError("tethers must be a kitsuke.cloth.Tethers or None")
+    if tethers is not None and len(tethers) and tethers.tri.max() >= model.n_vertices:
+        raise InputError("tethers name cloth vertices the model does not have")
     forward = active_edge_index(model, state)
     backward = np.ascontiguousarray(forward[::-1])
     movable = vertex_active(model, state) & ~state.pinned
@@ -66,10 +77,18 @@ def restore_lengths(
         stats.worst_error_m = float(
             K.project_lengths(state.positions, model.edges, model.rest_lengths, movable, backward if s % 2 else forward)
         )
+        if tethers is not None and len(tethers):
+            stats.worst_tether_m = float(
+                K.project_tethers(
+                    state.positions, tethers.tri, tethers.bary, movable, tethers.line_points, tethers.line_start,
+                    tethers.line_of, tethers.reach_m,
+                )
+            )
         stats.sweeps += 1
-        last = s == sweeps - 1 or stats.worst_error_m <= tolerance_m
+        last = s == sweeps - 1 or max(stats.worst_error_m, stats.worst_tether_m) <= tolerance_m
         if collider is not None and ((s + 1) % collide_every == 0 or last):
             stats.searches += collide(model, state, collider).searches
         if last:
             break
     return stats
+

@@ -1,0 +1,66 @@
+"""Tethers: points on the cloth that must stay within a reach of a polyline (a body stroke, for the wrap).
+
+A one-sided constraint: a point nearer than the reach is left alone, one farther is pulled straight back to it.
+So the cloth keeps its own rest wherever that rest already meets the request, and only where it does not is the
+cloth moved, by the least it takes (`_kernels.project_tethers`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+
+
+@dataclass(frozen=True)
+class Tethers:
+    """Cloth points held within `reach_m` of polylines.
+
+    tri : (n, 3) int64 cloth vertices of the triangle holding each point; bary : (n, 3) float64 its barycentric
+    coordinates. line_points : (K, 3) float64 metres, the polylines one after another; line_start : (L + 1,)
+    int64, polyline l is line_points[line_start[l]:line_start[l + 1]]; line_of : (n,) int64, each point's
+    polyline. reach_m : metres.
+    """
+
+    tri: np.ndarray
+    bary: np.ndarray
+    line_points: np.ndarray
+    line_start: np.ndarray
+    line_of: np.ndarray
+    reach_m: float
+
+    @classmethod
+    def from_polylines(
+        cls, groups: list[tuple[np.ndarray, np.ndarray, np.ndarray]], faces: np.ndarray, reach_m: float
+    ) -> Tethers:
+        """Tethers from (face indices (n,), barycentric (n, 3), polyline (k, 3)) groups, one per polyline, on a
+        cloth whose triangles are `faces` (F, 3)."""
+        if not reach_m > 0:
+            raise InputError(f"tether reach must be > 0 metres, got {reach_m}")
+        tri, bary, lines, line_of = [], [], [], []
+        for l, (face_ids, b, line) in enumerate(groups):
+            line = np.asarray(line, dtype=np.float64).reshape(-1, 3)
+            if len(line) < 1:
+                raise InputError(f"tether polyline {l} has no points")
+            tri.append(np.asarray(faces)[np.asarray(face_ids, dtype=np.int64)])
+            bary.append(np.asarray(b, dtype=np.float64).reshape(-1, 3))
+            lines.append(line)
+            line_of.append(np.full(len(face_ids), l, dtype=np.int64))
+        if not groups:
+            return cls(
+                np.zeros((0, 3), np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(1, np.int64),
+                np.zeros(0, np.int64), float(reach_m),
+            )
+        return cls(
+            tri=np.ascontiguousarray(np.concatenate(tri), dtype=np.int64),
+            bary=np.ascontiguousarray(np.concatenate(bary)),
+            line_points=np.ascontiguousarray(np.concatenate(lines)),
+            line_start=np.concatenate([[0], np.cumsum([len(x) for x in lines])]).astype(np.int64),
+            line_of=np.concatenate(line_of),
+            reach_m=float(reach_m),
+        )
+
+    def __len__(self) -> int:
+        return len(self.tri)
