@@ -80,8 +80,14 @@ def restore_lengths(
         if tethers is not None and len(tethers):
             stats.worst_tether_m = float(
                 K.project_tethers(
-                    state.positions, tethers.tri, tethers.bary, movable, tethers.line_points, tethers.line_start,
-                    tethers.line_of, tethers.reach_m,
+                    state.positions,
+                    tethers.tri,
+                    tethers.bary,
+                    movable,
+                    tethers.line_points,
+                    tethers.line_start,
+                    tethers.line_of,
+                    tethers.reach_m,
                 )
             )
         stats.sweeps += 1
@@ -91,4 +97,3 @@ def restore_lengths(
         if last:
             break
     return stats
-

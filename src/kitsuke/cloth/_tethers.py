@@ -50,8 +50,12 @@ class Tethers:
             line_of.append(np.full(len(face_ids), l, dtype=np.int64))
         if not groups:
             return cls(
-                np.zeros((0, 3), np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(1, np.int64),
-                np.zeros(0, np.int64), float(reach_m),
+                np.zeros((0, 3), np.int64),
+                np.zeros((0, 3)),
+                np.zeros((0, 3)),
+                np.zeros(1, np.int64),
+                np.zeros(0, np.int64),
+                float(reach_m),
             )
         return cls(
             tri=np.ascontiguousarray(np.concatenate(tri), dtype=np.int64),

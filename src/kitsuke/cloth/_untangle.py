@@ -150,8 +150,14 @@ def untangle(
                     relax(local, state, collider, iterations=len(chunk))
                     for _ in range(TETHER_PASSES):  # points sharing a vertex move each other: a few passes
                         if not K.project_tethers(
-                            state.positions, tethers.tri, tethers.bary, free, tethers.line_points,
-                            tethers.line_start, tethers.line_of, tethers.reach_m,
+                            state.positions,
+                            tethers.tri,
+                            tethers.bary,
+                            free,
+                            tethers.line_points,
+                            tethers.line_start,
+                            tethers.line_of,
+                            tethers.reach_m,
                         ):
                             break
         finally:

@@ -413,7 +413,13 @@ class DragSession:
         if p.release_relax_iterations:
             relax(self.model, self.state, self.collider, iterations=p.release_relax_iterations)
         if p.release_untangle_rounds:
-            untangle(self.model, self.state, self.collider, rounds=p.release_untangle_rounds, iterations=p.release_untangle_iterations)
+            untangle(
+                self.model,
+                self.state,
+                self.collider,
+                rounds=p.release_untangle_rounds,
+                iterations=p.release_untangle_iterations,
+            )
         self._track_feet()
 
     def _global_step(self, solver: GlobalRelax) -> float:
