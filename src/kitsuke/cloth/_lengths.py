@@ -78,18 +78,7 @@ def restore_lengths(
             K.project_lengths(state.positions, model.edges, model.rest_lengths, movable, backward if s % 2 else forward)
         )
         if tethers is not None and len(tethers):
-            stats.worst_tether_m = float(
-                K.project_tethers(
-                    state.positions,
-                    tethers.tri,
-                    tethers.bary,
-                    movable,
-                    tethers.line_points,
-                    tethers.line_start,
-                    tethers.line_of,
-                    tethers.reach_m,
-                )
-            )
+            stats.worst_tether_m = tethers.project(state.positions, movable)
         stats.sweeps += 1
         last = s == sweeps - 1 or max(stats.worst_error_m, stats.worst_tether_m) <= tolerance_m
         if collider is not None and ((s + 1) % collide_every == 0 or last):

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+from . import _kernels as K
 
 
 @dataclass(frozen=True)
@@ -68,3 +69,14 @@ class Tethers:
 
     def __len__(self) -> int:
         return len(self.tri)
+
+    def project(self, positions: np.ndarray, movable: np.ndarray) -> float:
+        """One sweep (in place on positions (V, 3)): every point beyond its reach pulled back to it, its vertices
+        moving only where `movable` (V,) bool is set on all three. Returns the farthest beyond reach met, metres."""
+        if not len(self):
+            return 0.0
+        return float(
+            K.project_tethers(
+                positions, self.tri, self.bary, movable, self.line_points, self.line_start, self.line_of, self.reach_m
+            )
+        )

@@ -149,16 +149,7 @@ def untangle(
                 for chunk in np.array_split(np.arange(iterations), TETHER_CHUNKS):
                     relax(local, state, collider, iterations=len(chunk))
                     for _ in range(TETHER_PASSES):  # points sharing a vertex move each other: a few passes
-                        if not K.project_tethers(
-                            state.positions,
-                            tethers.tri,
-                            tethers.bary,
-                            free,
-                            tethers.line_points,
-                            tethers.line_start,
-                            tethers.line_of,
-                            tethers.reach_m,
-                        ):
+                        if not tethers.project(state.positions, free):
                             break
         finally:
             state.pinned = pinned
