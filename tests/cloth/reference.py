@@ -199,7 +199,7 @@ def project_lengths(pos, edges, rest, movable, order):
 
 def project_tethers(pos, tri, bary, movable, lines, line_of, reach):
     """One sweep of tethers: each cloth point (barycentric in its triangle) farther than `reach` from its polyline
-    (lines[line_of[i]], (k, 3)) is moved towards the polyline's nearest point until it is `reach` away, its
+    (lines[line_of[i]], (k, 3); one point: that point) is moved towards the polyline's nearest point until it is `reach` away, its
     vertices sharing the move in proportion to their barycentric weight; a point with a fixed vertex stays."""
     pos = pos.copy()
     worst = 0.0
@@ -209,7 +209,7 @@ def project_tethers(pos, tri, bary, movable, lines, line_of, reach):
         p = bary[i] @ pos[tri[i]]
         line = lines[line_of[i]]
         best, q = np.inf, None
-        for a, b in zip(line[:-1], line[1:], strict=True):
+        for a, b in zip(line[:-1], line[1:], strict=True) if len(line) > 1 else [(line[0], line[0])]:
             e = b - a
             t = 0.0 if e @ e <= 1e-24 else float(np.clip((p - a) @ e / (e @ e), 0.0, 1.0))
             c = a + t * e

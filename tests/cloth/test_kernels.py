@@ -180,7 +180,8 @@ def test_project_lengths_matches_reference_and_keeps_fixed_vertices(crumpled, rn
 
 
 def test_project_tethers_matches_reference_and_moves_only_what_is_out_of_reach(crumpled, rng):
-    """Points on random triangles tethered to two random polylines: the kernel moves what the numpy reference
+    """Points on random triangles tethered to two random polylines (through `Tethers.project`, so with its
+    nearest-segment cache): the kernel moves what the numpy reference
     moves, leaves fixed vertices and points already within reach alone, and puts the rest exactly at reach."""
     model, pos = crumpled
     n = 40
@@ -193,9 +194,7 @@ def test_project_tethers_matches_reference_and_moves_only_what_is_out_of_reach(c
     movable = rng.random(model.n_vertices) > 0.2
     movable[tethers.tri[-1]] = True
     got = pos.copy()
-    worst = K.project_tethers(
-        got, tethers.tri, tethers.bary, movable, tethers.line_points, tethers.line_start, tethers.line_of, 0.02
-    )
+    worst = tethers.project(got, movable)
     expect, expect_worst = ref.project_tethers(pos, tethers.tri, tethers.bary, movable, lines, tethers.line_of, 0.02)
     np.testing.assert_allclose(got, expect, atol=ATOL)
     assert worst == pytest.approx(expect_worst) and worst > 0
@@ -207,3 +206,32 @@ def test_project_tethers_matches_reference_and_moves_only_what_is_out_of_reach(c
     a, b = lines[1][:-1], lines[1][1:]
     t = np.clip(np.einsum("ij,ij->i", p - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0, 1)
     assert np.linalg.norm(p - (a + t[:, None] * (b - a)), axis=1).min() <= 0.02 + 1e-9
+
+
+def test_project_tethers_cache_gives_the_full_search_result(crumpled, rng):
+    """The nearest-segment cache only skips searches: over sweeps with small moves (where it is used) and jumps
+    (where it must search again), every sweep equals the numpy reference's full search; a one-point polyline is
+    a point."""
+    model, pos = crumpled
+    n = 30
+    faces = rng.integers(0, model.n_faces, n)
+    bary = rng.dirichlet(np.ones(3), n)
+    centre = pos.mean(axis=0)
+    lines = [centre + rng.normal(0.0, 0.04, (12, 3)), centre + rng.normal(0.0, 0.01, (1, 3))]
+    tethers = Tethers.from_polylines(
+        [(faces[:20], bary[:20], lines[0]), (faces[20:], bary[20:], lines[1])], model.faces, reach_m=0.01
+    )
+    movable = np.ones(model.n_vertices, dtype=bool)
+    got = pos.copy()
+    used = 0
+    for sweep in range(12):
+        step = 0.05 if sweep % 4 == 3 else 5e-4  # every fourth sweep a jump past other segments
+        got += rng.normal(0.0, step, got.shape)
+        before = tethers._seg.copy(), tethers._snap.copy()
+        expect, expect_worst = ref.project_tethers(got, tethers.tri, tethers.bary, movable, lines, tethers.line_of, 0.01)
+        worst = tethers.project(got, movable)
+        used += int(((tethers._snap == before[1]).all(axis=1) & (before[0] >= 0)).sum())
+        np.testing.assert_allclose(got, expect, atol=ATOL)
+        assert worst == pytest.approx(expect_worst)
+    assert used > 0  # the cache was used in some sweep (else this test shows nothing)
+    assert np.isfinite(got).all()

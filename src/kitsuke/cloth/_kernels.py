@@ -362,8 +362,28 @@ def project_lengths(pos, edges, rest_lengths, movable, order):
     return worst
 
 
+#: Segments either side of a tether point's last nearest one that `project_tethers` searches while its cache holds.
+TETHER_WINDOW = 4
+
+
 @njit(cache=True)
-def project_tethers(pos, tri, bary, movable, line_points, line_start, line_of, reach):
+def _segment_nearest(px, py, pz, line_points, j, last):
+    """Nearest point to p on segment j of a polyline whose last point is `last` (a one-point polyline: that
+    point). Returns (squared distance, x, y, z)."""
+    ax, ay, az = line_points[j, 0], line_points[j, 1], line_points[j, 2]
+    t = 0.0
+    ex = ey = ez = 0.0
+    if j < last:
+        ex, ey, ez = line_points[j + 1, 0] - ax, line_points[j + 1, 1] - ay, line_points[j + 1, 2] - az
+        ee = ex * ex + ey * ey + ez * ez
+        if ee > TINY2:
+            t = min(1.0, max(0.0, ((px - ax) * ex + (py - ay) * ey + (pz - az) * ez) / ee))
+    cx, cy, cz = ax + t * ex, ay + t * ey, az + t * ez
+    return (px - cx) ** 2 + (py - cy) ** 2 + (pz - cz) ** 2, cx, cy, cz
+
+
+@njit(cache=True)
+def project_tethers(pos, tri, bary, movable, line_points, line_start, line_of, reach, seg, second, snap):
     """One sweep of tethers (in place on pos (V, 3)): each cloth point p = sum_k bary[i, k] * pos[tri[i, k]]
     farther than `reach` metres from its polyline (points line_points[line_start[l]:line_start[l + 1]], l =
     line_of[i]) is pulled straight towards the polyline's nearest point until it is `reach` away, its vertices
@@ -371,6 +391,13 @@ def project_tethers(pos, tri, bary, movable, line_points, line_start, line_of, r
     that may not move is left to it: moving only the others could take a vertex of small weight far (by the
     distance over its weight). Returns the largest distance beyond `reach` met in the sweep, metres (before the
     correction), over the points it may move.
+
+    seg (n,) int64, second (n,) float64, snap (n, 3) float64: a cache of each point's nearest segment (-1: none
+    yet), updated in place. When a point was last searched at `snap`, every segment more than TETHER_WINDOW
+    segments from the nearest was at least `second` metres away, so it is still at least `second - |p - snap|`
+    away now: while the best segment of that window is nearer than that, it is the nearest and only the window
+    is searched (exact, not a heuristic; the cloth moves far less per sweep than that). Same result as a full
+    search every time.
     """
     worst = 0.0
     for i in range(tri.shape[0]):
@@ -383,19 +410,31 @@ def project_tethers(pos, tri, bary, movable, line_points, line_start, line_of, r
             py += bary[i, k] * pos[v, 1]
             pz += bary[i, k] * pos[v, 2]
         l = line_of[i]
-        best = math.inf
-        qx = qy = qz = 0.0
-        for j in range(line_start[l], line_start[l + 1] - 1):
-            ax, ay, az = line_points[j, 0], line_points[j, 1], line_points[j, 2]
-            ex, ey, ez = line_points[j + 1, 0] - ax, line_points[j + 1, 1] - ay, line_points[j + 1, 2] - az
-            ee = ex * ex + ey * ey + ez * ez
-            t = 0.0
-            if ee > TINY2:
-                t = min(1.0, max(0.0, ((px - ax) * ex + (py - ay) * ey + (pz - az) * ez) / ee))
-            cx, cy, cz = ax + t * ex, ay + t * ey, az + t * ez
-            d2 = (px - cx) ** 2 + (py - cy) ** 2 + (pz - cz) ** 2
-            if d2 < best:
-                best, qx, qy, qz = d2, cx, cy, cz
+        first, last = line_start[l], line_start[l + 1] - 1
+        stop = max(last, first + 1)  # segments first..stop-1 (one for a one-point polyline)
+        found = False
+        best = qx = qy = qz = 0.0
+        if seg[i] >= 0:
+            best = math.inf
+            for j in range(max(first, seg[i] - TETHER_WINDOW), min(stop, seg[i] + TETHER_WINDOW + 1)):
+                d2, cx, cy, cz = _segment_nearest(px, py, pz, line_points, j, last)
+                if d2 < best:
+                    best, qx, qy, qz = d2, cx, cy, cz
+            moved = math.sqrt((px - snap[i, 0]) ** 2 + (py - snap[i, 1]) ** 2 + (pz - snap[i, 2]) ** 2)
+            found = math.sqrt(best) < second[i] - moved
+        if not found:
+            best = math.inf
+            for j in range(first, stop):
+                d2, cx, cy, cz = _segment_nearest(px, py, pz, line_points, j, last)
+                if d2 < best:
+                    best, qx, qy, qz = d2, cx, cy, cz
+                    seg[i] = j
+            outside = math.inf
+            for j in range(first, stop):
+                if abs(j - seg[i]) > TETHER_WINDOW:
+                    outside = min(outside, _segment_nearest(px, py, pz, line_points, j, last)[0])
+            second[i] = math.sqrt(outside)
+            snap[i, 0], snap[i, 1], snap[i, 2] = px, py, pz
         d = math.sqrt(best)
         over = d - reach
         if over <= 0.0:

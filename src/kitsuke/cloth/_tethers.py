@@ -7,7 +7,7 @@ cloth moved, by the least it takes (`_kernels.project_tethers`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -21,8 +21,10 @@ class Tethers:
 
     tri : (n, 3) int64 cloth vertices of the triangle holding each point; bary : (n, 3) float64 its barycentric
     coordinates. line_points : (K, 3) float64 metres, the polylines one after another; line_start : (L + 1,)
-    int64, polyline l is line_points[line_start[l]:line_start[l + 1]]; line_of : (n,) int64, each point's
-    polyline. reach_m : metres.
+    int64, polyline l is line_points[line_start[l]:line_start[l + 1]] (one point: that point); line_of : (n,)
+    int64, each point's polyline. reach_m : metres.
+    `project` keeps a nearest-segment cache here (see `_kernels.project_tethers`): it skips searches and never
+    changes a result.
     """
 
     tri: np.ndarray
@@ -31,6 +33,15 @@ class Tethers:
     line_start: np.ndarray
     line_of: np.ndarray
     reach_m: float
+    _seg: np.ndarray = field(init=False, repr=False, compare=False)
+    _second: np.ndarray = field(init=False, repr=False, compare=False)
+    _snap: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        n = len(self.tri)
+        object.__setattr__(self, "_seg", np.full(n, -1, dtype=np.int64))
+        object.__setattr__(self, "_second", np.zeros(n))
+        object.__setattr__(self, "_snap", np.zeros((n, 3)))
 
     @classmethod
     def from_polylines(
@@ -77,6 +88,16 @@ class Tethers:
             return 0.0
         return float(
             K.project_tethers(
-                positions, self.tri, self.bary, movable, self.line_points, self.line_start, self.line_of, self.reach_m
+                positions,
+                self.tri,
+                self.bary,
+                movable,
+                self.line_points,
+                self.line_start,
+                self.line_of,
+                self.reach_m,
+                self._seg,
+                self._second,
+                self._snap,
             )
         )
