@@ -199,8 +199,9 @@ def project_lengths(pos, edges, rest, movable, order):
 
 def project_tethers(pos, tri, bary, movable, lines, line_of, reach):
     """One sweep of tethers: each cloth point (barycentric in its triangle) farther than `reach` from its polyline
-    (lines[line_of[i]], (k, 3); one point: that point) is moved towards the polyline's nearest point until it is `reach` away, its
-    vertices sharing the move in proportion to their barycentric weight; a point with a fixed vertex stays."""
+    (lines[line_of[i]], (k, 3); one point: that point) is moved towards the polyline's nearest point until it is
+    `reach` away, its vertices sharing the move in proportion to their barycentric weight; a point with a fixed
+    vertex stays."""
     pos = pos.copy()
     worst = 0.0
     for i in range(len(tri)):

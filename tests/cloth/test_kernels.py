@@ -228,7 +228,9 @@ def test_project_tethers_cache_gives_the_full_search_result(crumpled, rng):
         step = 0.05 if sweep % 4 == 3 else 5e-4  # every fourth sweep a jump past other segments
         got += rng.normal(0.0, step, got.shape)
         before = tethers._seg.copy(), tethers._snap.copy()
-        expect, expect_worst = ref.project_tethers(got, tethers.tri, tethers.bary, movable, lines, tethers.line_of, 0.01)
+        expect, expect_worst = ref.project_tethers(
+            got, tethers.tri, tethers.bary, movable, lines, tethers.line_of, 0.01
+        )
         worst = tethers.project(got, movable)
         used += int(((tethers._snap == before[1]).all(axis=1) & (before[0] >= 0)).sum())
         np.testing.assert_allclose(got, expect, atol=ATOL)

@@ -136,6 +136,34 @@ def test_quality_report_pass_and_fail(box):
     assert lenient.passed["max_strain"] and lenient.passed["mean_strain"]
 
 
+def test_quality_report_says_where_the_worst_edge_and_the_first_fold_are(box):
+    """With the pieces given, a failing report names the piece and the place of the worst edge and of the first
+    inverted triangle; without them it says nothing of where."""
+    uv, f = grid_sheet(5, 5, 0.01)
+    edges = mesh_edges(f)
+    rest = np.linalg.norm(uv[edges[:, 0]] - uv[edges[:, 1]], axis=1)
+    pos = np.c_[uv - 0.02, np.full(len(uv), 0.105)]
+    corner = len(uv) - 1  # the sheet's last corner; the second piece starts at the first triangle touching it
+    split = int(np.flatnonzero((f == corner).any(axis=1)).min())
+    assert 0 < split < len(f) - 1
+    pieces = (["left", "right"], np.array([[0, split], [split, len(f)]]))
+    pos[corner] += [0.0, 0.0, 0.02]  # a spike there: its edges stretched
+    r = quality_report(pos, f, box, rest_lengths=rest, pieces=pieces)
+    a, b = edges[r.strain_worst_edges[0]]
+    mid = (pos[a] + pos[b]) / 2
+    assert r.strain_worst_at == f"piece right at ({mid[0]:.3f}, {mid[1]:.3f}, {mid[2]:.3f}) m"
+    assert any(line.endswith(f"(worst on {r.strain_worst_at})") for line in r.failures())
+    folded = pos.copy()
+    v = f[0, 0]  # fold the first triangle's corner back over its neighbours (first piece)
+    folded[v] = folded[f[0]].mean(axis=0) + 0.6 * (folded[f[0]].mean(axis=0) - folded[v])
+    r = quality_report(folded, f, box, rest_lengths=rest, pieces=pieces)
+    assert r.inverted_count >= 1 and r.inverted_at.startswith("piece left at (")
+    assert any("(first on piece left at" in line for line in r.failures())
+    plain = quality_report(pos, f, box, rest_lengths=rest)
+    assert plain.strain_worst_at is None and plain.inverted_at is None
+    assert all("worst on" not in line for line in plain.failures())
+
+
 def test_quality_report_rejects_bad_input(box):
     uv, f = grid_sheet(3, 3, 0.01)
     pos = np.c_[uv, np.zeros(len(uv))]

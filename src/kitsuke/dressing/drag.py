@@ -286,7 +286,12 @@ class DragSession:
         """The SPEC §6 quality report of the garment now against the body."""
         m = self.model
         return quality_report(
-            self.state.positions, m.faces, self.body_mesh, rest_lengths=m.rest_lengths, rest_areas=m.rest_areas
+            self.state.positions,
+            m.faces,
+            self.body_mesh,
+            rest_lengths=m.rest_lengths,
+            rest_areas=m.rest_areas,
+            pieces=(self._file.piece_names, self._file.piece_faces),
         )
 
     def snapshot(self) -> _Snapshot:

@@ -283,7 +283,14 @@ def rewrap(
     out = dataclasses.replace(g, positions=pos.copy())
     rep = None
     if report:
-        rep = quality_report(pos, g.faces, mesh, rest_lengths=model.rest_lengths, rest_areas=model.rest_areas)
+        rep = quality_report(
+            pos,
+            g.faces,
+            mesh,
+            rest_lengths=model.rest_lengths,
+            rest_areas=model.rest_areas,
+            pieces=(g.piece_names, g.piece_faces),
+        )
     return Rewrapped(
         garment=out,
         pinned=pinned,

@@ -471,7 +471,12 @@ def wrap(
     )
     if report:
         result.report = quality_report(
-            state.positions, model.faces, mesh, rest_lengths=model.rest_lengths, rest_areas=model.rest_areas
+            state.positions,
+            model.faces,
+            mesh,
+            rest_lengths=model.rest_lengths,
+            rest_areas=model.rest_areas,
+            pieces=(result.piece_names, result.piece_faces),
         )
         timings["report"] = time.perf_counter() - t6
     return result

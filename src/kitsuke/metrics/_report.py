@@ -35,7 +35,9 @@ class QualityReport:
     penetration_count : vertices deeper than targets.penetration_mm inside the body. penetration_deepest_mm : the
     deepest vertex inside (mm, 0 if none). strain_mean, strain_max : edge strain (fractions). strain_worst_edges :
     indices into the edges, worst first. seam_gap_mm : largest gap over all seams, seam_gaps_mm per seam.
-    inverted_count, inverted_faces (the first 20). passed : {measure: bool}; ok : all passed.
+    inverted_count, inverted_faces (the first 20). strain_worst_at, inverted_at : where the worst edge and the
+    first inverted triangle lie ("piece NAME at (x, y, z) m"; None without pieces, see `quality_report`), so a
+    report that fails says where to look. passed : {measure: bool}; ok : all passed.
     """
 
     n_vertices: int
@@ -53,21 +55,25 @@ class QualityReport:
     inverted_faces: list[int]
     targets: QualityTargets = field(default_factory=QualityTargets)
     passed: dict[str, bool] = field(default_factory=dict)
+    strain_worst_at: str | None = None
+    inverted_at: str | None = None
 
     @property
     def ok(self) -> bool:
         return all(self.passed.values())
 
     def failures(self) -> list[str]:
-        """One line per measure that missed its target, saying by how much."""
+        """One line per measure that missed its target, saying by how much (and where, when the report knows)."""
         t = self.targets
+        worst = "" if self.strain_worst_at is None else f" (worst on {self.strain_worst_at})"
+        first = "" if self.inverted_at is None else f" (first on {self.inverted_at})"
         lines = {
             "penetration": f"{self.penetration_count} vertices deeper than {t.penetration_mm} mm inside the body "
             f"(deepest {self.penetration_deepest_mm:.1f} mm)",
-            "max_strain": f"max edge strain {100 * self.strain_max:.1f} % > {100 * t.max_strain:.1f} %",
+            "max_strain": f"max edge strain {100 * self.strain_max:.1f} % > {100 * t.max_strain:.1f} %{worst}",
             "mean_strain": f"mean edge strain {100 * self.strain_mean:.2f} % > {100 * t.mean_strain:.2f} %",
             "seam_gap": f"seam gap {self.seam_gap_mm:.1f} mm > {t.seam_gap_mm} mm",
-            "inverted": f"{self.inverted_count} inverted triangles > {t.inverted}",
+            "inverted": f"{self.inverted_count} inverted triangles > {t.inverted}{first}",
         }
         return [lines[k] for k, v in self.passed.items() if not v]
 
@@ -87,12 +93,15 @@ def quality_report(
     seams: Sequence[tuple[np.ndarray, np.ndarray]] = (),
     rest_areas: np.ndarray | None = None,
     targets: QualityTargets | None = None,
+    pieces: tuple[Sequence[str], np.ndarray] | None = None,
 ) -> QualityReport:
     """All quality measures of cloth at `positions` (V, 3) metres with `faces` (F, 3) on `body`.
 
     rest_lengths : (E,) metres, per edge of `edges` (default `mesh_edges(faces)`, the order ClothModel uses).
     seams : pairs of vertex index arrays (see `seam_gap`); none for a sewn mesh that shares seam vertices.
     rest_areas : (F,) square metres, to count collapsed triangles as inverted (see `inverted_triangles`).
+    pieces : (names (P,), piece_faces (P, 2) int64 [start, stop) face ranges), to say on which piece, and where,
+        the worst edge and the first inverted triangle lie.
     """
     t = targets or QualityTargets()
     pos = _points(positions, "positions")
@@ -120,6 +129,20 @@ def quality_report(
         inverted_faces=[int(i) for i in inv[:20]],
         targets=t,
     )
+    if pieces is not None and len(f):
+        names, ranges = pieces
+        piece_of = np.asarray(ranges)[:, 1]
+
+        def where(face: int, point: np.ndarray) -> str:
+            name = names[min(int(np.searchsorted(piece_of, face, side="right")), len(names) - 1)]
+            return f"piece {name} at ({point[0]:.3f}, {point[1]:.3f}, {point[2]:.3f}) m"
+
+        if len(st.worst_edges):
+            a, b = e[st.worst_edges[0]]
+            face = int(np.flatnonzero((f == a).any(axis=1) & (f == b).any(axis=1))[0])
+            report.strain_worst_at = where(face, (pos[a] + pos[b]) / 2)
+        if len(inv):
+            report.inverted_at = where(int(inv[0]), pos[f[inv[0]]].mean(axis=0))
     report.passed = {
         "penetration": pen.count == 0,
         "max_strain": st.max <= t.max_strain,
