@@ -19,7 +19,7 @@ from ._relax import RelaxStats, relax
 from ._shapes import grid_sheet, grid_tube, hugging_tube, triangle_frames
 from ._subdivide import Refinement, colliding_edges, refine, sqrt3_split
 from ._tethers import Tethers
-from ._untangle import UntangleStats, folded_faces, untangle
+from ._untangle import UntangleStats, folded_faces, grow_region, untangle
 
 __all__ = [
     "BodyCollider",
@@ -35,6 +35,7 @@ __all__ = [
     "UntangleStats",
     "collide",
     "folded_faces",
+    "grow_region",
     "colliding_edges",
     "grid_sheet",
     "grid_tube",

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..cloth import ClothModel, ClothState
-from ..cloth._untangle import grow_region
+from ..cloth import ClothModel, ClothState, grow_region
+from ..metrics import strain
 from ._grow import grow
 
 
@@ -35,12 +35,6 @@ class MendStats:
     torn_before: int = 0
     torn_after: int = 0
     regrown: int = 0
-
-
-def edge_strain(model: ClothModel, positions: np.ndarray) -> np.ndarray:
-    """(E,) |length / rest length - 1| of every edge."""
-    e = model.edges
-    return np.abs(np.linalg.norm(positions[e[:, 1]] - positions[e[:, 0]], axis=1) / model.rest_lengths - 1.0)
 
 
 def mend_tears(
@@ -61,7 +55,7 @@ def mend_tears(
     and `close()` is run.
     """
     stats = MendStats()
-    torn = edge_strain(model, state.positions) > tear_strain
+    torn = strain(state.positions, model.edges, model.rest_lengths).per_edge > tear_strain
     stats.torn_before = int(torn.sum())
     while torn.any() and stats.rounds < rounds:
         seed = np.zeros(model.n_vertices, dtype=bool)
@@ -78,6 +72,6 @@ def mend_tears(
         close()
         stats.rounds += 1
         stats.regrown += int(off.sum())
-        torn = edge_strain(model, state.positions) > tear_strain
+        torn = strain(state.positions, model.edges, model.rest_lengths).per_edge > tear_strain
     stats.torn_after = int(torn.sum())
     return stats
