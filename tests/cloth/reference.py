@@ -179,8 +179,9 @@ def segment_segment_distance(p1, q1, p2, q2, samples: int = 20001):
     return np.linalg.norm(x - (p2 + t * u), axis=1).min()
 
 
-def project_lengths(pos, edges, rest, movable, order):
-    """One Gauss-Seidel sweep in `order`: each edge's movable ends moved along it, equally, to its rest length."""
+def project_lengths(pos, edges, rest, movable, order, omega=1.0):
+    """One Gauss-Seidel sweep in `order`: each edge's movable ends moved along it, equally, to its rest length
+    (omega times the way there)."""
     pos = pos.copy()
     worst = 0.0
     for e in order:
@@ -191,7 +192,7 @@ def project_lengths(pos, edges, rest, movable, order):
         d = pos[b] - pos[a]
         length = np.linalg.norm(d)
         worst = max(worst, abs(length - rest[e]))
-        corr = (length - rest[e]) / w.sum() * d / length
+        corr = omega * (length - rest[e]) / w.sum() * d / length
         pos[a] += w[0] * corr
         pos[b] -= w[1] * corr
     return pos, worst

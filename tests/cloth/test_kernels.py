@@ -166,17 +166,23 @@ def test_project_lengths_matches_reference_and_keeps_fixed_vertices(crumpled, rn
     model, pos = crumpled
     movable = rng.random(model.n_vertices) > 0.2
     order = rng.permutation(model.n_edges).astype(np.int64)
-    got = pos.copy()
-    worst = K.project_lengths(got, model.edges, model.rest_lengths, movable, order)
-    expect, expect_worst = ref.project_lengths(pos, model.edges, model.rest_lengths, movable, order)
-    np.testing.assert_allclose(got, expect, atol=ATOL)
-    assert worst == pytest.approx(expect_worst)
-    np.testing.assert_array_equal(got[~movable], pos[~movable])
-    # The last edge of the sweep ends at its rest length if one of its ends could move.
-    last = order[-1]
-    if movable[model.edges[last]].any():
-        a, b = model.edges[last]
-        assert np.linalg.norm(got[b] - got[a]) == pytest.approx(model.rest_lengths[last])
+    for omega in (1.0, 1.5):
+        got = pos.copy()
+        worst = K.project_lengths(got, model.edges, model.rest_lengths, movable, order, omega)
+        expect, expect_worst = ref.project_lengths(pos, model.edges, model.rest_lengths, movable, order, omega)
+        np.testing.assert_allclose(got, expect, atol=ATOL)
+        assert worst == pytest.approx(expect_worst)
+        np.testing.assert_array_equal(got[~movable], pos[~movable])
+        # The last edge of the sweep ends at its rest length if one of its ends could move, or past it by half
+        # its error when over-relaxed.
+        last = order[-1]
+        if movable[model.edges[last]].any():
+            a, b = model.edges[last]
+            before = pos.copy()
+            K.project_lengths(before, model.edges, model.rest_lengths, movable, order[:-1], omega)
+            err = np.linalg.norm(before[b] - before[a]) - model.rest_lengths[last]
+            expect_len = model.rest_lengths[last] + (1.0 - omega) * err
+            assert np.linalg.norm(got[b] - got[a]) == pytest.approx(expect_len)
 
 
 def test_project_tethers_matches_reference_and_moves_only_what_is_out_of_reach(crumpled, rng):

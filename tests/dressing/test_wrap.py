@@ -287,6 +287,9 @@ def test_wrap_rejects_a_missing_piece_and_bad_params():
         WrapParams(stick_weight=-1.0)
     with pytest.raises(InputError, match="length_sweeps"):
         WrapParams(length_sweeps=-1)
+    for omega in (0.5, 2.0, float("nan")):
+        with pytest.raises(InputError, match="length_over_relaxation"):
+            WrapParams(length_over_relaxation=omega)
     with pytest.raises(InputError, match="hold_reach_m"):
         WrapParams(hold_reach_m=0.0)
     with pytest.raises(InputError, match="hold_reach_m"):

@@ -332,11 +332,12 @@ def limit_strain(order, n_order, rank, movable, adj_ptr, adj, adj_edge, rest_len
 
 
 @njit(cache=True)
-def project_lengths(pos, edges, rest_lengths, movable, order):
+def project_lengths(pos, edges, rest_lengths, movable, order, omega):
     """One Gauss-Seidel sweep (in place on pos (V, 3)): each edge in `order` moves its movable ends, half each
-    (all of it for one movable end), along the edge until it has its rest length. Returns the largest length
-    error met in the sweep, metres (before its correction). Sequential on purpose: each projection sees the
-    previous ones, which is what makes a sweep converge where a Jacobi average would cancel itself out.
+    (all of it for one movable end), along the edge until it has its rest length, times `omega` (1: exactly;
+    1 < omega < 2: over-relaxed, past it). Returns the largest length error met in the sweep, metres (before its
+    correction). Sequential on purpose: each projection sees the previous ones, which is what makes a sweep
+    converge where a Jacobi average would cancel itself out.
     """
     worst = 0.0
     for o in range(len(order)):
@@ -352,7 +353,7 @@ def project_lengths(pos, edges, rest_lengths, movable, order):
             continue
         err = d - rest_lengths[e]
         worst = max(worst, abs(err))
-        f = err / (d * (wa + wb))
+        f = omega * err / (d * (wa + wb))
         pos[a, 0] += wa * f * dx
         pos[a, 1] += wa * f * dy
         pos[a, 2] += wa * f * dz

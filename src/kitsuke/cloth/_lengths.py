@@ -20,6 +20,9 @@ from ._collide import BodyCollider, active_edge_index, collide, vertex_active
 from ._model import ClothModel, ClothState
 from ._tethers import Tethers
 
+#: Sweeps at the end of `restore_lengths` that are never over-relaxed.
+PLAIN_FINISH = 100
+
 
 @dataclass
 class LengthStats:
@@ -45,6 +48,7 @@ def restore_lengths(
     collide_every: int = 3,
     tolerance_m: float = 0.0,
     tethers: Tethers | None = None,
+    over_relaxation: float = 1.0,
 ) -> LengthStats:
     """Pull every edge of the active triangles towards its rest length (in place on `state`).
 
@@ -56,13 +60,19 @@ def restore_lengths(
         this beyond its reach, metres (0: stop only at a sweep that found nothing to correct).
     tethers : cloth points kept within a reach of polylines, projected after the edges in every sweep, so the
         edges settle around them (the wrap keeps its pattern strokes near their body strokes this way).
+    over_relaxation : omega of successive over-relaxation, 1 <= omega < 2: each edge is moved omega times the
+        way to its rest length, which carries a correction across the garment in fewer sweeps; the last
+        PLAIN_FINISH sweeps are plain (omega 1), so the edges end at rest rather than overshooting it (measured
+        after the shirt's wrap at 1.5: 1.26 % mean strain without them, 0.75 % with 20-200).
     Pinned vertices, and vertices of no active triangle, do not move.
     """
     if not isinstance(state, ClothState):
         raise InputError("restore_lengths needs a ClothModel and a ClothState")
     state.check(model)
-    if sweeps < 0 or collide_every < 1 or not tolerance_m >= 0:
-        raise InputError("restore_lengths needs sweeps >= 0, collide_every >= 1 and tolerance_m >= 0")
+    if sweeps < 0 or collide_every < 1 or not tolerance_m >= 0 or not 1.0 <= over_relaxation < 2.0:
+        raise InputError(
+            "restore_lengths needs sweeps >= 0, collide_every >= 1, tolerance_m >= 0 and 1 <= over_relaxation < 2"
+        )
     if collider is not None and not isinstance(collider, BodyCollider):
         raise InputError("collider must be a BodyCollider or None")
     if tethers is not None and not isinstance(tethers, Tethers):
@@ -74,8 +84,11 @@ def restore_lengths(
     movable = vertex_active(model, state) & ~state.pinned
     stats = LengthStats()
     for s in range(sweeps):
+        omega = over_relaxation if s < sweeps - PLAIN_FINISH else 1.0
         stats.worst_error_m = float(
-            K.project_lengths(state.positions, model.edges, model.rest_lengths, movable, backward if s % 2 else forward)
+            K.project_lengths(
+                state.positions, model.edges, model.rest_lengths, movable, backward if s % 2 else forward, omega
+            )
         )
         if tethers is not None and len(tethers):
             stats.worst_tether_m = tethers.project(state.positions, movable)
