@@ -118,8 +118,8 @@ class WrapParams:
     tear_strain : fraction, or None. After the close, cloth round edges stretched more than this (1.0: twice
         their rest length) is grown again from the closed cloth around it and closed again (`_mend.mend_tears`):
         where growth wrapped it round the wrong side of a limb, the limb goes through it and the close cannot pull
-        it back. Max strain of the finished wrap without -> with: GarmentCode's shirt at 1 cm 774 -> 45 %, at
-        2 cm 433 -> 37 %; the kimono's sleeves at 2-2.5 cm stay torn (177 -> 302 %, 276 -> 135 %: regrown, they
+        it back. Max strain of the finished wrap without -> with: GarmentCode's shirt at 1 cm 774 -> 40 %, at
+        2 cm 433 -> 37 %; the kimono's sleeves at 2-2.5 cm stay torn (177 -> 301 %, 276 -> 130 %: regrown, they
         catch on the forearm again). The shipped 1.5 cm cases never reach it (worst after the close: 83 %), so
         they are unchanged. None: no mending.
     mend_rounds : most mending rounds (0: none).
