@@ -16,14 +16,17 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
    of one piece meet are repaired first, `repair_corners`), so where two grown regions meet at a seam the
    triangles between them are stretched. A closing relaxation without gravity (`_solve.GlobalRelax`: a global
    least-squares solve per iteration, which removes such garment-wide distortion in tens of iterations where the
-   Jacobi `relax` needs thousands) pulls them shut, the strokes only softly held (`stroke_hold`).
+   Jacobi `relax` needs thousands) pulls them shut, the strokes only softly held (`stroke_hold`). Where edges
+   are still over twice their length after it (growth took the cloth round the wrong side of a limb), that
+   cloth is grown again from the closed cloth around it and closed again (`_mend`, `tear_strain`).
 4. **Settle**: relaxation with gravity and collision, the stroke pins released (or, `settle="global"`, global
    steps with gravity, the body contacts inside the solve and static friction: `_solve.gravity_settle`).
    Optionally a band of the garment (e.g. where a kimono's obi goes) is held: its vertices over the torso are
    pinned where they are after step 3 (`_band_held`), for the settle only (the finish has no gravity).
 5. **Finish**: a few global relaxation steps without gravity take back the stretch the settle's gravity left in
    cloth resting on the body (`finish_iterations`); then Gauss-Seidel sweeps projecting each edge to its rest
-   length take out the local strain that they leave (`length_sweeps`, `kitsuke.cloth.restore_lengths`). The
+   length, over-relaxed, take out the local strain that they leave (`length_sweeps`, `length_over_relaxation`,
+   `kitsuke.cloth.restore_lengths`). The
    sweeps also pull each pattern stroke back within `stroke_reach_m` of its body stroke where the settle let it
    hang farther (one-sided tethers, `kitsuke.cloth.Tethers`), so the strokes are met and the rest drapes freely.
 6. **Untangle** (`kitsuke.cloth.untangle`, also run at the end of step 3, before a hold band is pinned):
@@ -100,7 +103,7 @@ class WrapParams:
         sweeps): shirt 1.43 -> 0.81 %, hoody 1.51 -> 0.94 %, T-shirt 1.08 -> 0.46 %, kimono 1.79 -> 0.89 %.
     length_over_relaxation : omega of the length sweeps (`restore_lengths`' over_relaxation; 1: plain
         Gauss-Seidel). Mean / max strain at 1200 sweeps, 1 -> 1.5: shirt 0.87 -> 0.75 % / 30 -> 28 %, hoody 0.87
-        -> 0.84 % / 29 -> 29 %, T-shirt 0.46 -> 0.39 % / 26 -> 18 %, kimono 0.64 -> 0.66 % / 65 -> 69 %; 800
+        -> 0.84 % / 29 -> 29 %, T-shirt 0.46 -> 0.39 % / 26 -> 18 %, kimono 0.64 -> 0.64 % / 65 -> 63 %; 800
         sweeps at 1.5 match 1200 at 1.
     stroke_reach_m : metres, or None. The length restoration and the last untangle keep every pattern stroke
         within this distance of its body stroke (`kitsuke.cloth.Tethers`: a one-sided pull on the stroke's 32
