@@ -26,9 +26,9 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
 5. **Finish**: a few global relaxation steps without gravity take back the stretch the settle's gravity left in
    cloth resting on the body (`finish_iterations`); then Gauss-Seidel sweeps projecting each edge to its rest
    length, over-relaxed, take out the local strain that they leave (`length_sweeps`, `length_over_relaxation`,
-   `kitsuke.cloth.restore_lengths`). The
-   sweeps also pull each pattern stroke back within `stroke_reach_m` of its body stroke where the settle let it
-   hang farther (one-sided tethers, `kitsuke.cloth.Tethers`), so the strokes are met and the rest drapes freely.
+   `kitsuke.cloth.restore_lengths`). The sweeps also pull each pattern stroke back within `stroke_reach_m` of its
+   body stroke where the settle let it hang farther (one-sided tethers, `kitsuke.cloth.Tethers`), so the strokes
+   are met and the rest drapes freely.
 6. **Untangle** (`kitsuke.cloth.untangle`, also run at the end of step 3, before a hold band is pinned):
    triangles still folded over their neighbours are opened by relaxing only a few rings of cloth around them,
    the rest of the garment held still (`untangle_rounds`); the stroke tethers still apply.
