@@ -95,6 +95,7 @@ def test_wrap_quality(dressed):
     assert r.strain_max < case.strain_max
     assert r.inverted_count == 0
     np.testing.assert_allclose(g.stroke_length_ratio, 1.0, atol=0.01)
+    assert g.mend.torn_before == 0  # the close leaves no edge over twice its length: nothing was regrown
 
 
 def test_garment_sits_where_it_should(dressed):
@@ -133,7 +134,7 @@ def test_without_tethers_the_garment_settles_away_from_its_strokes():
     assert g.report.penetration_count == 0 and g.report.inverted_count == 0
 
 
-@pytest.mark.xfail(strict=True, reason="issue 3 target not met: max strain 18-28 % (vertices with > 360° of pattern)")
+@pytest.mark.xfail(strict=True, reason="issue 3 target not met: max strain 13-30 % (vertices with > 360° of pattern)")
 def test_issue_targets(dressed):
     _, g = dressed
     assert g.report.strain_max <= 0.05

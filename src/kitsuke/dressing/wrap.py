@@ -23,12 +23,12 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
    steps with gravity, the body contacts inside the solve and static friction: `_solve.gravity_settle`).
    Optionally a band of the garment (e.g. where a kimono's obi goes) is held: its vertices over the torso are
    pinned where they are after step 3 (`_band_held`), for the settle only (the finish has no gravity).
-5. **Finish**: a few global relaxation steps without gravity take back the stretch the settle's gravity left in
-   cloth resting on the body (`finish_iterations`); then Gauss-Seidel sweeps projecting each edge to its rest
-   length, over-relaxed, take out the local strain that they leave (`length_sweeps`, `length_over_relaxation`,
-   `kitsuke.cloth.restore_lengths`). The sweeps also pull each pattern stroke back within `stroke_reach_m` of its
-   body stroke where the settle let it hang farther (one-sided tethers, `kitsuke.cloth.Tethers`), so the strokes
-   are met and the rest drapes freely.
+5. **Finish**: Gauss-Seidel sweeps projecting each edge to its rest length, over-relaxed, take back the stretch
+   the settle's gravity left in cloth resting on the body and the local strain (`length_sweeps`,
+   `length_over_relaxation`, `kitsuke.cloth.restore_lengths`; optionally after a few global relaxation steps
+   without gravity, `finish_iterations`, 0 by default). The sweeps also pull each pattern stroke back within
+   `stroke_reach_m` of its body stroke where the settle let it hang farther (one-sided tethers,
+   `kitsuke.cloth.Tethers`), so the strokes are met and the rest drapes freely.
 6. **Untangle** (`kitsuke.cloth.untangle`, also run at the end of step 3, before a hold band is pinned):
    triangles still folded over their neighbours are opened by relaxing only a few rings of cloth around them,
    the rest of the garment held still (`untangle_rounds`); the stroke tethers still apply.
@@ -49,7 +49,7 @@ from ..geometry.surface import Surface
 from ..metrics import QualityReport, quality_report
 from ..pattern import Pattern, PatternMesh, mesh_pattern
 from ._grow import grow
-from ._mend import mend_tears
+from ._mend import MendStats, mend_tears
 from ._place import StrokeTrack, place_strokes
 from ._solve import GlobalRelax, gravity_settle
 from ._weld import repair_corners, weld
@@ -96,7 +96,10 @@ class WrapParams:
         holds, the settle's pins kept) after the settle. The Jacobi settle lets gravity stretch cloth that rests
         on the body (shirt: contact edges 2.1 % -> 4.1 % stretch), far more than real fabric stretches under its
         own weight; these steps take that back and keep the drape (shirt mean strain 2.13 -> 1.43 %, hoody 2.08
-        -> 1.41 %).
+        -> 1.41 %). Off by default since the length sweeps are over-relaxed, which take it back as well: mean /
+        max strain of the whole wrap at 10 -> 0 steps: shirt 0.75 -> 0.84 % / 28 -> 30 %, hoody 0.84 -> 0.82 % /
+        29 -> 24 %, T-shirt 0.39 -> 0.41 % / 18 -> 13 %, kimono 0.64 -> 0.68 % / 63 -> 64 %; the shirt's wrap
+        ~0.25 s faster (bench_wrap median 1.81-1.86 -> 1.58-1.63 s).
     length_sweeps : Gauss-Seidel sweeps of `kitsuke.cloth.restore_lengths` after the finish (with collision, the
         settle's pins kept, a hold band let go): the least-squares steps take out strain spread over the garment
         but slowly; edge projection takes out the local rest. Mean strain without -> with (15 close steps, 1200
@@ -155,7 +158,7 @@ class WrapParams:
     settle_iterations: int = 60
     settle_gravity_m: float = 0.002
     stick_weight: float = 20.0
-    finish_iterations: int = 10
+    finish_iterations: int = 0
     length_sweeps: int = 1200
     length_over_relaxation: float = 1.5
     stroke_reach_m: float | None = 0.008
@@ -241,7 +244,8 @@ class DressedGarment:
     stroke_ids : stroke ids in drawing order. stroke_residual_m : (S,) float64 metres, for each stroke the largest
         distance of its pattern stroke (on the garment) to its body stroke after the settle.
     stroke_length_ratio : (S,) body stroke length / pattern stroke length (1 = the stroke asks for no stretch).
-    rings : growth rings. timings : seconds per step ("mesh", "resolve", "place", "grow", "close", "settle", "finish",
+    rings : growth rings. mend : what `_mend.mend_tears` did after the close (rounds, torn edges before and
+        after). timings : seconds per step ("mesh", "resolve", "place", "grow", "close", "settle", "finish",
         "untangle", "wrap" = all of them, "report").
     report : the SPEC §6 quality report against the body.
     """
@@ -261,6 +265,7 @@ class DressedGarment:
     stroke_length_ratio: np.ndarray = field(default_factory=lambda: np.zeros(0))
     tracks: list[StrokeTrack] = field(default_factory=list, repr=False)
     rings: int = 0
+    mend: MendStats = field(default_factory=MendStats)
     timings: dict[str, float] = field(default_factory=dict)
     report: QualityReport | None = None
 
@@ -283,6 +288,7 @@ class DressedGarment:
             "vertices": self.n_vertices,
             "faces": len(self.faces),
             "rings": self.rings,
+            "mend": dataclasses.asdict(self.mend),
             "timings_s": {k: round(v, 4) for k, v in self.timings.items()},
             "strokes": [
                 {"id": i, "residual_mm": round(float(r) * 1e3, 2), "length_ratio": round(float(q), 4)}
@@ -404,6 +410,7 @@ def wrap(
     # Close: the global relaxation (see _solve), stroke pins released so that collision reaches the stroke
     # triangles too; they are only held softly towards where the strokes put them (`stroke_hold`).
     state.pinned = np.zeros(model.n_vertices, dtype=bool)
+    mended = MendStats()
     if p.close_iterations:
         targets = state.positions.copy()
 
@@ -422,7 +429,7 @@ def wrap(
 
         close()
         if p.tear_strain is not None and p.mend_rounds:
-            mend_tears(
+            mended = mend_tears(
                 model,
                 state,
                 placement.seed_faces,
@@ -513,6 +520,7 @@ def wrap(
         stroke_length_ratio=ratio,
         tracks=placement.tracks,
         rings=rings,
+        mend=mended,
         timings=timings,
     )
     if report:
