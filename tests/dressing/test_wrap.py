@@ -275,6 +275,8 @@ def test_wrap_rejects_a_missing_piece_and_bad_params():
         wrap(_sphere(), _square(), bad)
     with pytest.raises(InputError):
         WrapParams(rings_per_relax=0)
+    with pytest.raises(InputError, match="close_cg_iterations"):
+        WrapParams(close_cg_iterations=0)
     with pytest.raises(InputError):
         WrapParams(hold_band_m=(1.0, 0.9))
     with pytest.raises(InputError, match="stroke_hold"):

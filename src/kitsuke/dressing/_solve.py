@@ -47,7 +47,8 @@ class GlobalRelax:
     stick_weight : static friction for the gravity settle: a vertex touching the body at its first step is held
     along the body (tangentially; leaving the body stays free) at where it was, with this weight relative to
     one triangle edge, until the solve pulls it off. Without it, gravity slides the whole garment down the
-    body (the contact planes are frictionless). All faces must be active (it runs after growth).
+    body (the contact planes are frictionless). cg_iterations : most conjugate-gradient iterations of a contact
+    solve. All faces must be active (it runs after growth).
     """
 
     def __init__(
@@ -60,6 +61,7 @@ class GlobalRelax:
         contact_weight: float = 0.0,
         gravity_m: float = 0.0,
         stick_weight: float = 0.0,
+        cg_iterations: int = CG_ITERATIONS,
     ):
         from scipy.sparse import coo_matrix
         from scipy.sparse.linalg import splu
@@ -89,6 +91,7 @@ class GlobalRelax:
         self.stick_at: np.ndarray | None = None  # (V, 3) where they were then
         self.released = np.zeros(nv, dtype=bool)
         self.cg_iterations = 0
+        self.cg_limit = int(cg_iterations)
         self.pinned = pinned.copy()
         nf = model.n_faces
         self._normals = np.zeros((nf, 3))
@@ -197,7 +200,7 @@ class GlobalRelax:
         rz = float((r * z).sum())
         tol = 1e-10 * float((b * b).sum())
         it = 0
-        for it in range(CG_ITERATIONS):  # noqa: B007 (counted below)
+        for it in range(self.cg_limit):  # noqa: B007 (counted below)
             ap = apply(p)
             alpha = rz / float((p * ap).sum())
             x += alpha * p
