@@ -161,6 +161,8 @@ def test_quality_report_says_where_the_worst_edge_and_the_first_fold_are(box):
     assert any("(first on piece left at" in line for line in r.failures())
     plain = quality_report(pos, f, box, rest_lengths=rest)
     assert plain.strain_worst_at is None and plain.inverted_at is None
+    with pytest.raises(InputError, match="pieces"):
+        quality_report(pos, f, box, rest_lengths=rest, pieces=(["left"], pieces[1]))
     assert all("worst on" not in line for line in plain.failures())
 
 

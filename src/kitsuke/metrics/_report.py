@@ -131,7 +131,10 @@ def quality_report(
     )
     if pieces is not None and len(f):
         names, ranges = pieces
-        piece_of = np.asarray(ranges)[:, 1]
+        ranges = np.asarray(ranges)
+        if ranges.shape != (len(names), 2) or not len(names) or ranges[-1, 1] != len(f):
+            raise InputError(f"pieces must name {len(names)} [start, stop) face ranges ending at {len(f)} faces")
+        piece_of = ranges[:, 1]
 
         def where(face: int, point: np.ndarray) -> str:
             name = names[min(int(np.searchsorted(piece_of, face, side="right")), len(names) - 1)]
