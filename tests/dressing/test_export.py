@@ -82,6 +82,8 @@ def test_dress_bad_input_is_exit_2_and_writes_nothing(run_cli, tmp_path):
         (["--strokes", str(tmp_path / "missing.json")], "missing.json"),
         (["--strokes", str(SHIRT_STROKES), "--obj", str(SHIRT)], "must end in .obj"),
         (["--strokes", str(SHIRT_STROKES), "--stroke-reach", "-1"], "--stroke-reach must be between 0 and 100 mm"),
+        (["--strokes", str(SHIRT_STROKES), "--hang", "-1"], "--hang must be between 0 and 10"),
+        (["--strokes", str(SHIRT_STROKES), "--hang", "nan"], "--hang must be between 0 and 10"),
     ]
     for extra, needle in cases:
         r = run_cli("dress", "--body", MEAN_ALL, "--pattern", SHIRT, "-o", out, *extra)
@@ -96,6 +98,34 @@ def test_dress_bad_input_is_exit_2_and_writes_nothing(run_cli, tmp_path):
         "dress", "--body", MEAN_ALL, "--garment", SHIRT, "--strokes", SHIRT_STROKES, "-o", out, "--stroke-reach", "5"
     )
     assert r.code == 2 and "--stroke-reach is for a wrap" in r.err and not out.exists()
+    r = run_cli("dress", "--body", MEAN_ALL, "--garment", SHIRT, "--strokes", SHIRT_STROKES, "-o", out, "--hang", "2")
+    assert r.code == 2 and "--hang is for a wrap" in r.err and not out.exists()
+
+
+def test_dress_a_kimono_pattern_like_the_demo(run_cli, tmp_path):
+    """A kimono pattern file (`kitsuke pattern kimono`) on the default body is dressed as the demo dresses it:
+    sleeves hanging as bags (their lowest point far below the elbow; measured 30 / 32 cm at 2.5 cm edges, the
+    size used here to keep the test short) and the waist held in the obi band (the report's pinned count)."""
+    from kitsuke.body import default_body
+    from kitsuke.skeleton import INDEX
+
+    pattern, obj, report = tmp_path / "kimono.json", tmp_path / "k.obj", tmp_path / "k.json"
+    assert run_cli("pattern", "kimono", "--fit-height", "1.666", "-o", pattern).code == 0
+    strokes = ROOT / "src" / "kitsuke" / "assets" / "strokes" / "kimono_default.json"
+    r = run_cli(
+        "dress", "--body", "default", "--pattern", pattern, "--strokes", strokes, "--edge-length", "2.5",
+        "-o", tmp_path / "k.glb", "--obj", obj, "--report", report,
+    )  # fmt: skip
+    assert r.code == 0, r.err
+    g = read_garment_obj(obj)
+    elbow = default_body().rig.joints[INDEX["l_elbow"], 1]
+    for k, name in enumerate(g.piece_names):
+        if name.startswith("sode"):
+            v = np.unique(g.faces[g.piece_faces[k, 0] : g.piece_faces[k, 1]])
+            assert elbow - g.positions[v, 1].min() > 0.25, name
+    summary = json.loads(report.read_text())
+    assert summary["held_vertices"] > 100  # the obi band
+    assert summary["quality"]["penetration_count"] == 0 and summary["quality"]["inverted_count"] == 0
 
 
 def test_read_garment_obj_rejects_plain_meshes(tmp_path):

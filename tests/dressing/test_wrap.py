@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from kitsuke.body import load_body
-from kitsuke.cloth import ClothModel, ClothState
+from kitsuke.cloth import ClothModel, ClothParams, ClothState, relax
 from kitsuke.dressing import BodyStroke, PatternStroke, StrokePair, Strokes, read_strokes
 from kitsuke.dressing._grow import grow, unfold
 from kitsuke.dressing._place import _extended_coordinates
@@ -74,6 +74,86 @@ def test_growth_of_a_flat_pattern_is_exact_without_relaxation():
     e = model.edges
     length = np.linalg.norm(state.positions[e[:, 0]] - state.positions[e[:, 1]], axis=1)
     np.testing.assert_allclose(length, model.rest_lengths, rtol=1e-9)
+
+
+def _two_triangles(angle_deg: float):
+    """A rest pair (0, 1, 2) + (1, 0, 3) sharing the edge 0-1 along x; the first triangle placed in 3D tilted
+    `angle_deg` above level about that edge, away from the second: (model, positions)."""
+    rest = np.array([[0.0, 0.0], [1.0, 0.0], [0.3, -0.8], [0.6, 0.7]])
+    model = ClothModel.from_flat(np.array([[0, 1, 2], [1, 0, 3]]), rest)
+    t = np.radians(angle_deg)
+    pos = np.zeros((4, 3))
+    pos[1] = [1.0, 0.0, 0.0]
+    pos[2] = [0.3, 0.8 * np.sin(t), 0.8 * np.cos(t)]  # the placed triangle lies on the +z side of the hinge
+    return model, pos, rest
+
+
+@pytest.mark.parametrize("angle", [0.0, 30.0])
+def test_unfold_with_hang_turns_cloth_off_the_body_down_about_its_hinge(angle):
+    """Hang turns the new triangle down about the shared edge: the new vertex keeps its rest distances to the
+    edge's ends (a rigid turn of the rest triangle), goes lower than straight on, and by the documented amount
+    (direction w + hang * down, normalised: from level, atan(2) = 63° down at hang 2)."""
+    model, pos, rest = _two_triangles(angle)
+    ring, k = np.array([1]), np.array([0])
+    _, straight = unfold(model, pos, ring, k)
+    _, hung = unfold(model, pos, ring, k, hang=2.0)
+    for end in (0, 1):
+        assert np.linalg.norm(hung[0] - pos[end]) == pytest.approx(np.linalg.norm(rest[3] - rest[end]), rel=1e-12)
+    assert hung[0, 1] < straight[0, 1] - 0.3
+    # Straight on goes down by `angle` (the placed triangle rises towards the hinge); w + 2 down from there.
+    t = np.radians(angle)
+    foot = np.array([0.6, 0.0, 0.0])  # where the new vertex's rest position projects onto the hinge
+    w = (hung[0] - foot) / np.linalg.norm(hung[0] - foot)
+    assert np.degrees(np.arcsin(-w[1])) == pytest.approx(np.degrees(np.arctan2(np.sin(t) + 2.0, np.cos(t))))
+
+
+def test_unfold_with_hang_leaves_cloth_on_the_body_and_cloth_growing_up_alone():
+    """No turn where the hinge touches the body (`off_body` False at either end), nor for cloth growing
+    upwards (a collar round the neck would fold back onto itself)."""
+    model, pos, _ = _two_triangles(0.0)
+    ring, k = np.array([1]), np.array([0])
+    _, straight = unfold(model, pos, ring, k)
+    on_body = np.array([True, False, True, True])
+    _, x = unfold(model, pos, ring, k, hang=2.0, off_body=on_body)
+    np.testing.assert_array_equal(x, straight)
+    model, pos, _ = _two_triangles(-60.0)  # the placed triangle below the hinge: the new one grows upwards
+    _, straight = unfold(model, pos, ring, k)
+    assert straight[0, 1] > 0.5
+    _, x = unfold(model, pos, ring, k, hang=2.0)
+    np.testing.assert_array_equal(x, straight)
+
+
+def test_growth_with_hang_makes_a_level_sheet_hang():
+    """A 20 cm sheet grown from a level triangle at one edge, with no body and the wrap's two relaxation
+    iterations (no gravity) after each ring: straight on it stays level; with hang it curls down, its far edge
+    well below where it started, its edges near their rest length (each triangle turns rigidly; a vertex placed
+    by several triangles takes their mean, which the relaxation evens out; measured median |strain| 1.5 %, which
+    the wrap's close takes out)."""
+    pm = mesh_pattern(_square(), edge_length=3.0)
+    w = weld(pm)
+    model = ClothModel.from_corners(
+        w.faces, w.rest_corners, n_vertices=w.n_vertices, params=ClothParams(gravity_step_m=0.0)
+    )
+    uv = np.zeros((w.n_vertices, 2))
+    uv[w.vertex_of] = pm.vertices_cm / 100.0
+    seed = int(np.argmin(uv[model.faces].mean(axis=1)[:, 0]))  # a face on the sheet's u = 0 side
+    ys = []
+    for hang in (0.0, 2.0):
+        placed = np.zeros(model.n_vertices, dtype=bool)
+        placed[model.faces[seed]] = True
+        pos = np.zeros((model.n_vertices, 3))
+        pos[placed] = np.c_[uv[placed, 0], np.zeros(placed.sum()), uv[placed, 1]]  # level: the xz plane
+        start = np.zeros(model.n_faces, dtype=bool)
+        start[seed] = True
+        state = ClothState.new(model, pos, face_active=start)
+        grow(model, state, placed, lambda _r, s=state: relax(model, s, iterations=2), hang=hang)
+        far = uv[:, 0] > 0.19
+        ys.append(state.positions[far, 1].mean())
+        e = model.edges
+        strain = np.linalg.norm(state.positions[e[:, 0]] - state.positions[e[:, 1]], axis=1) / model.rest_lengths - 1
+    assert abs(ys[0]) < 1e-6
+    assert ys[1] < -0.1
+    assert np.median(np.abs(strain)) < 0.03
 
 
 def test_weld_shares_every_seam_vertex():
@@ -228,15 +308,15 @@ def test_shirt_on_mean_all_structure(shirt):
 
 # -- the kimono on the default body --------------------------------------------------------------------------------
 def test_kimono_on_default_body(body, dressed_kimono):
-    """default_kimono() with the shipped strokes at 1.5 cm edges, its waist held in the obi band (what `kitsuke
-    demo` dresses). Measured 2026-11-24 (stroke tethers at 8 mm): no penetration, seams shared, no folded
-    triangle, strain mean 0.64 % and max 65 % (sleeve-bag edges), stroke residual 8.8 mm (targets: 1 % / 5 % /
-    10 mm: the max NOT met)."""
+    """default_kimono() with the shipped strokes at 1.5 cm edges, its waist held in the obi band and its sleeves
+    hanging (what `kitsuke demo` dresses). Measured 2026-11-25 (stroke tethers at 8 mm, hang 2): no penetration,
+    seams shared, no folded triangle, strain mean 0.51 % and max 60 % (compressed edges at a sleeve bag's bottom
+    corner), stroke residual 8.8 mm (targets: 1 % / 5 % / 10 mm: the max NOT met)."""
     g = dressed_kimono
     r = g.report
     assert r.penetration_count == 0 and r.seam_gap_mm == 0.0
-    assert r.strain_mean < 0.01  # measured 0.0064
-    assert r.strain_max < 0.9  # measured 0.65
+    assert r.strain_mean < 0.01  # measured 0.0051
+    assert r.strain_max < 0.9  # measured 0.60
     assert r.inverted_count == 0
     assert g.max_stroke_residual_m <= 0.01  # measured 0.0088: issue 3's target
     _, counts = edge_topology(g.faces)
@@ -254,6 +334,37 @@ def test_kimono_on_default_body(body, dressed_kimono):
         if name.startswith("sode"):
             sleeves[g.faces[g.piece_faces[k, 0] : g.piece_faces[k, 1]].reshape(-1)] = True
     assert not (g.pinned & sleeves).any()
+
+
+def test_kimono_sleeves_hang_below_the_arms(body, dressed_kimono):
+    """With `hang` (kimono_params) the sleeves' lower halves hang as bags: each sleeve's lowest point is far below
+    the elbow. Measured 2026-11-25: 34 / 36 cm below it; without hang the sleeves wrapped the forearms in
+    bunches, 8 / 13 cm below it (a real kimono's sleeve is 49 cm deep from its crease on top of the arm)."""
+    from kitsuke.skeleton import INDEX
+
+    g = dressed_kimono
+    for k, name in enumerate(g.piece_names):
+        if not name.startswith("sode"):
+            continue
+        v = np.unique(g.faces[g.piece_faces[k, 0] : g.piece_faces[k, 1]])
+        elbow = body.rig.joints[INDEX[f"{name[5]}_elbow"]]
+        assert elbow[1] - g.positions[v, 1].min() > 0.25, name
+
+
+def test_kimono_params():
+    """kimono_params: hang and the obi band for a rigged body; a band or hang given is kept; no band without a
+    rig; is_kimono reads the pattern's meta (kept through the pattern JSON)."""
+    from kitsuke.body import default_body
+    from kitsuke.dressing.kimono import KIMONO_HANG, is_kimono, kimono_params
+
+    b = default_body()
+    p = kimono_params(b)
+    assert p.hang == KIMONO_HANG and p.hold_band_m == obi_band(b)
+    assert kimono_params(b, WrapParams(hang=1.0)).hang == 1.0
+    assert kimono_params(b, WrapParams(hang=1.0), hang=0.0).hang == 0.0
+    assert kimono_params(b, WrapParams(hold_band_m=(0.5, 0.6))).hold_band_m == (0.5, 0.6)
+    assert kimono_params(b.mesh).hold_band_m is None
+    assert is_kimono(make_kimono()) and not is_kimono(load_pattern(SHIRT))
 
 
 # -- bad input -----------------------------------------------------------------------------------------------------
@@ -301,6 +412,9 @@ def test_wrap_rejects_a_missing_piece_and_bad_params():
             WrapParams(stroke_reach_m=reach)
     with pytest.raises(InputError, match="untangle_bend"):
         WrapParams(untangle_bend=-0.1)
+    for bad in (dict(hang=-1.0), dict(hang=float("nan")), dict(hang_clearance_m=-0.01)):
+        with pytest.raises(InputError, match="hang"):
+            WrapParams(**bad)
     with pytest.raises(InputError, match="no strokes"):
         wrap(_sphere(), _square(), Strokes([]))
     garment_target = Strokes(_sheet_strokes(0.3).pairs, target="garment")

@@ -17,6 +17,9 @@ By default the strokes place the garment and it then settles under gravity (the 
 stroke kept within 8 mm of its body stroke (--stroke-reach; 0 lets it settle freely, a centimetre or two away).
 --hold-strokes keeps the garment hanging from the strokes exactly instead.
 
+A kimono pattern (from `kitsuke pattern kimono`) is dressed the way the demo dresses it: its sleeves hang below
+the arms (--hang 2) and, on a rigged body (`default`), its waist is held where the obi goes while it settles.
+
 Outputs: OUT.glb for viewers (garment, double-sided, plus the body); --obj the checkable OBJ (v = world metres,
 vt = pattern metres, seam vertices shared, one `# kitsuke piece` line per piece); --report the quality report (JSON:
 penetration, strain, seam gap, inverted triangles, stroke residuals, timings); --png a front/side/back picture.
@@ -30,6 +33,9 @@ the pins (--pin X,Y,Z, metres, snapped to the nearest garment vertex, repeatable
 examples:
   kitsuke dress --body mean_all.obj --pattern shirt_mean_specification.json \\
                 --strokes shirt_mean_all.json -o shirt.glb --obj shirt.obj --report shirt.json --png shirt.png
+  kitsuke pattern kimono --fit-height 1.666 -o kimono.json
+  kitsuke dress --body default --pattern kimono.json --strokes src/kitsuke/assets/strokes/kimono_default.json \\
+                -o kimono.glb --png kimono.png
   kitsuke dress --body default --garment dressed.obj --strokes lift_sleeve.json \\
                 --pin 0,1.0,0.15 --pin 0,1.0,-0.15 -o rewrapped.glb --obj rewrapped.obj
 """
@@ -71,6 +77,15 @@ def register(parser: argparse.ArgumentParser) -> None:
         "freely: strokes met within millimetres, more strain where they ask for more than the pattern gives",
     )
     parser.add_argument(
+        "--hang",
+        type=float,
+        default=None,
+        metavar="STRENGTH",
+        help="how strongly cloth that grows off the body turns down as it grows (default 2 for a kimono "
+        "pattern, whose wide sleeves then hang as bags below the arms; 0 otherwise: fitted garments grow "
+        "straight on, the paper's way)",
+    )
+    parser.add_argument(
         "--stroke-reach",
         type=float,
         default=8.0,
@@ -84,6 +99,7 @@ def register(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..dressing import check_strokes, read_strokes
     from ..dressing.export import write_garment_glb, write_garment_obj, write_garment_png, write_garment_report
+    from ..dressing.kimono import is_kimono, kimono_params
     from ..dressing.wrap import WrapParams, wrap
     from ..errors import InputError
     from ..pattern import load_pattern
@@ -99,11 +115,15 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--edge-length must be between 0.2 and 10 cm, got {args.edge_length}")
     if not 0 <= args.stroke_reach <= 100:
         raise InputError(f"--stroke-reach must be between 0 and 100 mm, got {args.stroke_reach}")
+    if args.hang is not None and not 0 <= args.hang <= 10:
+        raise InputError(f"--hang must be between 0 and 10, got {args.hang}")
     if args.garment:
         if args.stroke_reach != 8.0:
             raise InputError("--stroke-reach is for a wrap: a re-wrap (--garment) holds its strokes already")
         if args.hold_strokes:
             raise InputError("--hold-strokes is for a wrap: a re-wrap (--garment) holds its strokes already")
+        if args.hang is not None:
+            raise InputError("--hang is for a wrap: a re-wrap (--garment) moves cloth already grown")
         return _rewrap(args, outs)
     if args.pin:
         raise InputError("--pin holds part of a dressed garment: use it with --garment (a re-wrap)")
@@ -114,7 +134,10 @@ def run(args: argparse.Namespace) -> int:
     body = body_from_args(args)
     make = WrapParams.strokes_held if args.hold_strokes else WrapParams
     reach = args.stroke_reach * 1e-3 if args.stroke_reach > 0 else None
-    garment = wrap(body, pattern, strokes, params=make(edge_length_cm=args.edge_length, stroke_reach_m=reach))
+    params = make(edge_length_cm=args.edge_length, stroke_reach_m=reach, hang=args.hang or 0.0)
+    if is_kimono(pattern):
+        params = kimono_params(body, params, hang=args.hang)
+    garment = wrap(body, pattern, strokes, params=params)
     write_garment_glb(garment, outs[0], body=body.mesh)
     if args.obj:
         write_garment_obj(garment, args.obj)

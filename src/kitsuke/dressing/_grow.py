@@ -16,6 +16,10 @@ import numpy as np
 
 from ..cloth import ClothModel, ClothState
 
+#: A triangle growing upwards (the y component of its direction away from the hinge at least this) does not turn
+#: down: turning it would fold it back onto the cloth it grows from (a collar growing up round the neck).
+HANG_UPWARD_LIMIT = 0.2
+
 
 def frontier(model: ClothModel, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Inactive faces with an active edge neighbour: (faces (n,), local edge k (n,) of the first such neighbour)."""
@@ -25,9 +29,22 @@ def frontier(model: ClothModel, active: np.ndarray) -> tuple[np.ndarray, np.ndar
     return ring, np.argmax(nbr[ring], axis=1)
 
 
-def unfold(model: ClothModel, positions: np.ndarray, ring: np.ndarray, k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def unfold(
+    model: ClothModel,
+    positions: np.ndarray,
+    ring: np.ndarray,
+    k: np.ndarray,
+    *,
+    hang: float = 0.0,
+    off_body: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Third-vertex positions of the faces `ring` unfolded across their local edge `k` from the neighbour there.
 
+    hang : how far a triangle unfolded from cloth off the body turns down about its hinge edge: its direction
+        away from the edge becomes that plus `hang` times the downward direction across the edge (0: straight on,
+        the paper's unfolding; 2: about 63° down from a level start). Only where the triangle does not already
+        grow upwards (it would fold back onto its neighbour) and, with `off_body` ((V,) bool), where both hinge
+        vertices are off the body.
     Returns (vertex (n,) int64, position (n, 3) metres).
     """
     f = model.faces[ring]
@@ -47,8 +64,16 @@ def unfold(model: ClothModel, positions: np.ndarray, ring: np.ndarray, k: np.nda
     eu = e / np.maximum(np.linalg.norm(e, axis=1, keepdims=True), 1e-300)
     w = pa - pd
     w -= np.einsum("ij,ij->i", w, eu)[:, None] * eu
-    wn = np.linalg.norm(w, axis=1, keepdims=True)
-    w = w / np.maximum(wn, 1e-300)
+    w = w / np.maximum(np.linalg.norm(w, axis=1, keepdims=True), 1e-300)
+    if hang > 0:
+        # Down, less its part along the hinge: a turn about the hinge keeps the triangle's rest shape.
+        down = eu[:, 1:2] * eu
+        down[:, 1] -= 1.0
+        turn = w[:, 1] < HANG_UPWARD_LIMIT
+        if off_body is not None:
+            turn &= off_body[a] & off_body[b]
+        w[turn] += hang * down[turn]
+        w[turn] /= np.maximum(np.linalg.norm(w[turn], axis=1, keepdims=True), 1e-300)
     return c, pa + along[:, None] * e + across[:, None] * w
 
 
@@ -59,15 +84,25 @@ def grow(
     relax_ring: Callable[[int], None],
     *,
     rings_per_relax: int = 1,
+    hang: float = 0.0,
+    hang_clearance_m: float = 0.03,
 ) -> int:
     """Grow `state.face_active` until no inactive face touches an active one; `placed` (V,) bool is updated in
-    place. `relax_ring(ring_number)` runs after every `rings_per_relax` rings. Returns the number of rings."""
+    place. `relax_ring(ring_number)` runs after every `rings_per_relax` rings. Returns the number of rings.
+
+    hang : see `unfold`; cloth counts as off the body where its tracked distance to the body
+        (`state.contacts`, refreshed by the relaxation's collision update) is at least `hang_clearance_m`.
+    """
     rings = 0
     while True:
         ring, k = frontier(model, state.face_active)
         if not len(ring):
             return rings
-        vert, x = unfold(model, state.positions, ring, k)
+        off_body = None
+        if hang > 0:
+            c = state.contacts
+            off_body = (c.face < 0) | (c.distance >= hang_clearance_m)
+        vert, x = unfold(model, state.positions, ring, k, hang=hang, off_body=off_body)
         new = ~placed[vert]
         if new.any():
             v = vert[new]

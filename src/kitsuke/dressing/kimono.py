@@ -1,10 +1,14 @@
-"""The kimono on the default body: the packaged strokes, and the band where the obi holds the waist.
+"""The kimono on the default body: the packaged strokes, the band where the obi holds the waist, and sleeves
+that hang.
 
-from kitsuke.dressing.kimono import dress_default_kimono
+from kitsuke.dressing.kimono import dress_default_kimono, kimono_params
 garment = dress_default_kimono()          # DressedGarment: default_kimono() on default_body()
+params = kimono_params(body)              # WrapParams for any kimono pattern on a rigged body
 """
 
 from __future__ import annotations
+
+import dataclasses
 
 from ..errors import InputError
 from ..skeleton import INDEX
@@ -14,6 +18,27 @@ from .wrap import DressedGarment, WrapParams, wrap
 OBI_WIDTH_M = 0.15
 #: The obi's lower edge below the rig's spine joint (the natural waist), metres.
 OBI_BELOW_WAIST_M = 0.02
+#: WrapParams.hang for a kimono: its sleeves' lower halves hang as bags below the arms (see WrapParams).
+KIMONO_HANG = 2.0
+
+
+def is_kimono(pattern) -> bool:
+    """Whether `pattern` (a kitsuke Pattern) is a kimono made by `kitsuke.pattern.make_kimono` (its meta says so,
+    also after a round trip through the kitsuke pattern JSON)."""
+    return "kimono" in getattr(pattern, "meta", {})
+
+
+def kimono_params(body, params: WrapParams | None = None, *, hang: float | None = None) -> WrapParams:
+    """`params` (default WrapParams()) made right for a kimono: sleeves that hang and, on a rigged body, the
+    waist held in the obi band (where `params` holds no band). `hang` sets WrapParams.hang; None keeps a hang
+    that `params` sets and gives KIMONO_HANG where it sets none (0)."""
+    p = params or WrapParams()
+    changes: dict = {}
+    if hang is not None or p.hang == 0.0:
+        changes["hang"] = KIMONO_HANG if hang is None else hang
+    if p.hold_band_m is None and getattr(body, "rig", None) is not None:
+        changes["hold_band_m"] = obi_band(body)
+    return dataclasses.replace(p, **changes)
 
 
 def obi_band(body) -> tuple[float, float]:
@@ -28,16 +53,14 @@ def obi_band(body) -> tuple[float, float]:
 
 def dress_default_kimono(body=None, *, params: WrapParams | None = None) -> DressedGarment:
     """Wrap `default_kimono()` on the default body with the packaged strokes `kimono_default`, its waist held in
-    the obi band. `body` defaults to `default_body()` (the strokes are drawn on it); `params` defaults to
-    WrapParams(hold_band_m=obi_band(body)); a given `params` without a hold band gets the obi band too."""
-    import dataclasses
-
+    the obi band and its sleeves hanging. `body` defaults to `default_body()` (the strokes are drawn on it);
+    `params` go through `kimono_params` (a band and a hang they set are kept)."""
     from ..body import default_body
     from ..pattern import default_kimono
     from . import load_packaged_strokes
 
     body = default_body() if body is None else body
     p = params or WrapParams()
-    if p.hold_band_m is None:
+    if p.hold_band_m is None:  # obi_band raises for a body without a rig
         p = dataclasses.replace(p, hold_band_m=obi_band(body))
-    return wrap(body, default_kimono(), load_packaged_strokes("kimono_default"), params=p)
+    return wrap(body, default_kimono(), load_packaged_strokes("kimono_default"), params=kimono_params(body, p))
