@@ -67,8 +67,8 @@ def register(parser: argparse.ArgumentParser) -> None:
         type=float,
         default=1.5,
         metavar="CM",
-        help="target triangle edge length of the garment mesh, cm (default 1.5; the shipped strokes are checked at "
-        "1.5, and a kimono's sleeves at 2 cm or more can catch on the arm: the report says where)",
+        help="target triangle edge length of the garment mesh, cm (default 1.5, what the shipped strokes are "
+        "checked at; coarser is faster, and where a coarse mesh catches on an arm the report says where)",
     )
     parser.add_argument(
         "--hold-strokes",
