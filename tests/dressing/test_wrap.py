@@ -412,6 +412,8 @@ def test_wrap_rejects_a_missing_piece_and_bad_params():
             WrapParams(stroke_reach_m=reach)
     with pytest.raises(InputError, match="untangle_bend"):
         WrapParams(untangle_bend=-0.1)
+    with pytest.raises(InputError, match="length_collide_every"):
+        WrapParams(length_collide_every=0)
     for bad in (dict(hang=-1.0), dict(hang=float("nan")), dict(hang_clearance_m=-0.01)):
         with pytest.raises(InputError, match="hang"):
             WrapParams(**bad)
