@@ -310,13 +310,13 @@ def test_shirt_on_mean_all_structure(shirt):
 def test_kimono_on_default_body(body, dressed_kimono):
     """default_kimono() with the shipped strokes at 1.5 cm edges, its waist held in the obi band and its sleeves
     hanging (what `kitsuke demo` dresses). Measured 2026-11-25 (stroke tethers at 8 mm, hang 2): no penetration,
-    seams shared, no folded triangle, strain mean 0.51 % and max 60 % (compressed edges at a sleeve bag's bottom
+    seams shared, no folded triangle, strain mean 0.52 % and max 65 % (compressed edges at a sleeve bag's bottom
     corner), stroke residual 8.8 mm (targets: 1 % / 5 % / 10 mm: the max NOT met)."""
     g = dressed_kimono
     r = g.report
     assert r.penetration_count == 0 and r.seam_gap_mm == 0.0
-    assert r.strain_mean < 0.01  # measured 0.0051
-    assert r.strain_max < 0.9  # measured 0.60
+    assert r.strain_mean < 0.01  # measured 0.0052
+    assert r.strain_max < 0.9  # measured 0.65
     assert r.inverted_count == 0
     assert g.max_stroke_residual_m <= 0.01  # measured 0.0088: issue 3's target
     _, counts = edge_topology(g.faces)
