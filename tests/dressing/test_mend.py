@@ -12,6 +12,7 @@ import pytest
 from kitsuke.body import load_body
 from kitsuke.cloth import ClothModel, ClothState, grid_sheet
 from kitsuke.dressing import read_strokes
+from kitsuke.dressing._grow import grow
 from kitsuke.dressing._mend import mend_tears
 from kitsuke.dressing.wrap import WrapParams, wrap
 from kitsuke.errors import InputError
@@ -37,7 +38,7 @@ def test_a_torn_sheet_is_grown_back_flat_and_the_rest_is_left_alone():
         model,
         state,
         np.zeros(model.n_faces, dtype=bool),
-        lambda _ring: None,
+        lambda placed: grow(model, state, placed, lambda _ring: None),
         lambda: closes.append(1),
         tear_strain=1.0,
         rings=1,
@@ -53,7 +54,7 @@ def test_nothing_torn_nothing_moved():
     state = ClothState.new(model, flat * [1.5, 1.0, 1.0])  # 50 % stretched: strained, not torn
     before = state.positions.copy()
     stats = mend_tears(
-        model, state, np.zeros(model.n_faces, dtype=bool), lambda _r: None, lambda: None, tear_strain=1.0
+        model, state, np.zeros(model.n_faces, dtype=bool), lambda placed: None, lambda: None, tear_strain=1.0
     )
     assert stats.rounds == 0 and stats.torn_before == 0
     np.testing.assert_array_equal(state.positions, before)
@@ -64,7 +65,7 @@ def test_the_stroke_triangles_are_kept():
     state = ClothState.new(model, flat.copy())
     state.positions[31] += [0.0, 0.0, 0.1]
     keep = np.ones(model.n_faces, dtype=bool)  # every triangle a stroke triangle: nothing may be regrown
-    stats = mend_tears(model, state, keep, lambda _r: None, lambda: None, tear_strain=1.0)
+    stats = mend_tears(model, state, keep, lambda placed: None, lambda: None, tear_strain=1.0)
     assert stats.rounds == 0 and stats.torn_after == stats.torn_before > 0
 
 

@@ -10,8 +10,10 @@ wrap); on the kimono at 2.5 cm, 4x across a sleeve.
 The mend takes the cloth round such edges off the body (its triangles made inactive again), grows it back from the
 closed cloth around it, which now lies where it should, and closes again. At the shipped 1.5 cm cases no edge is
 over twice its length after the close (the worst is 83 %, the hoody), so the mend leaves them untouched. Measured
-(max strain of the finished wrap, without -> with): the shirt at 1 cm 774 -> 40 %, at 2 cm 433 -> 37 %. The
-kimono's long sleeves at 2-2.5 cm are not mended: grown again, they catch on the forearm again.
+(max strain of the finished wrap, without -> with): the shirt at 1 cm 774 -> 40 %, at 2 cm 433 -> 37 %. (The
+kimono's long sleeves at 2-2.5 cm, grown straight on, caught on the forearm again when regrown; grown hanging,
+`WrapParams.hang`, they do not tear.) The cloth is regrown by the wrap's own growth (`grow_back`), so it hangs
+where the first growth would have made it hang.
 """
 
 from __future__ import annotations
@@ -23,7 +25,6 @@ import numpy as np
 
 from ..cloth import ClothModel, ClothState, grow_region
 from ..metrics import strain
-from ._grow import grow
 
 
 @dataclass
@@ -41,7 +42,7 @@ def mend_tears(
     model: ClothModel,
     state: ClothState,
     keep: np.ndarray,
-    relax_ring: Callable[[int], None],
+    grow_back: Callable[[np.ndarray], object],
     close: Callable[[], None],
     *,
     tear_strain: float,
@@ -51,8 +52,8 @@ def mend_tears(
     """Regrow the cloth round torn edges (in place on `state`): up to `rounds` times, while some edge is stretched
     more than `tear_strain` (a fraction: 1.0 = twice its rest length), the triangles within `rings` rings of every
     such edge (one ring more each round; 3 rings left the shirt at 1 cm torn) are made inactive (except those of
-    `keep` (F,) bool, the stroke triangles), grown back from the rest (`_grow.grow`, `relax_ring` after each ring)
-    and `close()` is run.
+    `keep` (F,) bool, the stroke triangles), grown back from the rest (`grow_back(placed)`: the wrap's growth,
+    `_grow.grow` with its relaxation, from the (V,) bool vertices still placed) and `close()` is run.
     """
     stats = MendStats()
     torn = strain(state.positions, model.edges, model.rest_lengths).per_edge > tear_strain
@@ -67,7 +68,7 @@ def mend_tears(
         state.face_active[off] = False
         placed = np.zeros(model.n_vertices, dtype=bool)
         placed[model.faces[state.face_active].reshape(-1)] = True
-        grow(model, state, placed, relax_ring)
+        grow_back(placed)
         state.face_active[off] = True  # a triangle no front reached (none, in a connected garment) keeps its place
         close()
         stats.rounds += 1

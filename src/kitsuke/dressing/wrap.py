@@ -64,14 +64,14 @@ class WrapParams:
     lift_m : the transferred stroke triangles are placed this far off the body, metres (just outside the cloth's
         contact offset, so collision does not fight the placement).
     rings_per_relax : growth rings between relaxations (more is faster, fewer keeps growth closer to the body).
-    hang : how strongly cloth growing off the body turns down as it grows (`_grow.unfold`); 0 grows straight
-        on (the paper's growth). Without it a kimono's sleeve, grown from its crease along the top of the arm,
-        wraps its lower half round the forearm in bunches, and no settle lets it fall (it touches the arm, and
-        friction holds it). With 2 (`kimono.KIMONO_HANG`) it hangs as a bag below the arm: the kimono's mean / max
-        strain 0.68 -> 0.51 % / 71 -> 60 % at 1.5 cm edges; its max 192 -> 39 % at 2 cm and 135 -> 66 % at 2.5 cm,
-        with nothing torn to mend. Not the default: on fitted garments it gains nothing and can cost (shirt 0.86
-        -> 0.84 % mean, hoody 0.87 -> 0.87 %; the T-shirt, whose loose front hangs off the belly, 0.40 -> 0.55 % /
-        12 -> 24 % with a crease down its front; the shirt at 2.5 cm edges 3 -> 7.9 mm deepest inside).
+    hang : how strongly cloth growing off the body turns down as it grows (`_grow.unfold`); 0 grows straight on (the
+        paper's growth). Without it a kimono's sleeve, grown from its crease along the top of the arm, wraps its lower
+        half round the forearm in bunches, and no settle lets it fall (it touches the arm, and friction holds it). With
+        2 (`kimono.KIMONO_HANG`) it hangs as a bag below the arm: the kimono's mean / max strain 0.68 -> 0.51 % / 71 ->
+        60 % at 1.5 cm edges (0.52 % / 65 % with length_collide_every 4); its max 192 -> 39 % at 2 cm and 135 -> 66 % at
+        2.5 cm, with nothing torn to mend. Not the default: on fitted garments it gains nothing and can cost (shirt 0.86
+        -> 0.84 % mean, hoody 0.87 -> 0.87 %; the T-shirt, whose loose front hangs off the belly, 0.40 -> 0.55 % / 12 ->
+        24 % with a crease down its front; the shirt at 2.5 cm edges 3 -> 7.9 mm deepest inside).
     hang_clearance_m : metres; cloth counts as off the body (turns down as it grows) where both vertices of the
         edge it grows from are at least this far from the body.
     grow_iterations : relaxation iterations (no gravity) after each group of rings.
@@ -414,17 +414,20 @@ def wrap(
     t3 = time.perf_counter()
     timings["place"] = t3 - t2
 
-    placed = placement.placed.copy()
+    def grow_from(placed: np.ndarray) -> int:
+        """Grow the inactive triangles from the placed vertices; also the mend's regrowth."""
+        return grow(
+            model,
+            state,
+            placed,
+            lambda _ring: relax(model, state, collider, iterations=p.grow_iterations),
+            rings_per_relax=p.rings_per_relax,
+            hang=p.hang,
+            hang_clearance_m=p.hang_clearance_m,
+        )
+
     # The seed faces' vertices are placed; faces whose three vertices are placed (next to a seed) join at once.
-    rings = grow(
-        model,
-        state,
-        placed,
-        lambda _ring: relax(model, state, collider, iterations=p.grow_iterations),
-        rings_per_relax=p.rings_per_relax,
-        hang=p.hang,
-        hang_clearance_m=p.hang_clearance_m,
-    )
+    rings = grow_from(placement.placed.copy())
     if not state.face_active.all():
         missing = np.flatnonzero(~state.face_active)
         piece_of = np.searchsorted(welded.piece_faces[:, 1], missing, side="right")
@@ -466,7 +469,7 @@ def wrap(
                 model,
                 state,
                 placement.seed_faces,
-                lambda _ring: relax(model, state, collider, iterations=p.grow_iterations),
+                grow_from,
                 close,
                 tear_strain=p.tear_strain,
                 rounds=p.mend_rounds,
