@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from kitsuke.errors import InputError
-from kitsuke.pattern import KimonoSize, make_kimono, validate
+from kitsuke.pattern import EdgeRef, KimonoSize, make_kimono, validate
 
 
 def size_of(pattern, name):
@@ -20,9 +20,41 @@ def test_standard_kimono(kimono):
     assert sorted(p.name for p in kimono.pieces) == sorted(
         ["migoro_right", "migoro_left", "okumi_right", "okumi_left", "sode_right", "sode_left", "eri"]
     )
-    assert len(kimono.seams) == 21
+    assert len(kimono.seams) == 23
     s = kimono.meta["kimono"]["size"]
     assert s["sleeve_width"] == 32.0 and s["shoulder"] + s["sleeve_width"] == s["yuki"] == 63.0
+    assert s["sleeve_round"] == 2.0
+
+
+@pytest.mark.parametrize("radius", [2.0, 8.0])
+def test_sleeve_bags_have_rounded_corners(radius):
+    """袖の丸み: each sleeve bag's bottom corner at the cuff is a quarter circle of the given radius, its front and
+    back halves sewn together (a square corner sewn there is a point with only 180° of cloth around it, which
+    the wrap crushed: 65 % strain on the demo's kimono). The bag's other seams shorten by the radius."""
+    p = make_kimono(KimonoSize(sleeve_round=radius))
+    s = p.meta["kimono"]["size"]
+    edges = p.meta["kimono"]["edges"]
+    for side in ("right", "left"):
+        sode, e = p.piece(f"sode_{side}"), edges[f"sode_{side}"]
+        for half in ("front", "back"):
+            assert e[f"{half}_round"] in sode.curves
+            assert sode.edge_length(e[f"{half}_round"]) == pytest.approx(np.pi * radius / 2, rel=1e-6)
+            assert sode.edge_length(e[f"{half}_bottom"]) == pytest.approx(s["sleeve_width"] - radius)
+            assert sode.edge_length(e[f"{half}_cuff_seam"]) == pytest.approx(
+                s["sleeve_depth"] - s["sleeve_opening"] - radius
+            )
+        # Each half loses a corner of R^2 (1 - pi / 4): the square's corner outside the quarter circle.
+        assert sode.area == pytest.approx(s["sleeve_width"] * 2 * s["sleeve_depth"] - 2 * radius**2 * (1 - np.pi / 4))
+        rounds = [q for q in p.seams if q.a == EdgeRef(f"sode_{side}", e["front_round"])]
+        assert len(rounds) == 1 and rounds[0].b == EdgeRef(f"sode_{side}", e["back_round"]) and rounds[0].reversed
+    assert validate(p) == []
+
+
+def test_square_sleeve_corners():
+    p = make_kimono(KimonoSize(sleeve_round=0))
+    assert len(p.seams) == 21
+    assert all(not p.piece(f"sode_{side}").curves for side in ("right", "left"))
+    assert "front_round" not in p.meta["kimono"]["edges"]["sode_left"]
 
 
 @pytest.mark.parametrize(
@@ -92,6 +124,10 @@ def test_placement_hints_close_the_seams_that_should_meet(kimono):
         ({"yuki": 70, "shoulder": 31, "bolt_width": 36}, "--sleeve-width", "does not fit the bolt width"),
         ({"shoulder": 40, "yuki": 72}, "--shoulder", "does not fit the bolt width"),
         ({"sleeve_depth": 22}, "--sleeve-attachment", None),
+        ({"sleeve_round": -1}, "--sleeve-round", "must be 0..15"),
+        ({"sleeve_round": 20}, "--sleeve-round", "must be 0..15"),
+        ({"sleeve_round": 12, "sleeve_depth": 30}, "--sleeve-round", "must be 0..6 cm"),
+        ({"sleeve_round": math.inf}, "--sleeve-round", "finite"),
     ],
 )
 def test_bad_measurements(kwargs, option, text):

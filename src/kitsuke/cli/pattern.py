@@ -170,7 +170,14 @@ def register(parser: argparse.ArgumentParser) -> None:
 
 
 #: KimonoSize's defaults, repeated here so that `kitsuke --help` does not import numpy (a test keeps them equal).
-KIMONO_DEFAULTS = {"length": 158.0, "yuki": 63.0, "shoulder": 31.0, "sleeve_depth": 49.0, "bolt_width": 37.0}
+KIMONO_DEFAULTS = {
+    "length": 158.0,
+    "yuki": 63.0,
+    "shoulder": 31.0,
+    "sleeve_depth": 49.0,
+    "bolt_width": 37.0,
+    "sleeve_round": 2.0,
+}
 
 
 def _size_arguments(p: argparse.ArgumentParser) -> None:
@@ -206,6 +213,13 @@ def _size_arguments(p: argparse.ArgumentParser) -> None:
         type=float,
         default=d["sleeve_depth"],
         help=f"袖丈 sleeve depth, crease to bottom (default {d['sleeve_depth']:g}; furisode ~114)",
+    )
+    g.add_argument(
+        "--sleeve-round",
+        type=float,
+        default=d["sleeve_round"],
+        help=f"袖の丸み radius of the sleeve's rounded bottom corner at the cuff (default {d['sleeve_round']:g}, "
+        "formal; everyday kimono 4-12; 0: square)",
     )
     g.add_argument(
         "--bolt-width",
@@ -299,6 +313,7 @@ def run_kimono(args: argparse.Namespace) -> int:
         sleeve_width=args.sleeve_width,
         sleeve_depth=args.sleeve_depth,
         bolt_width=args.bolt_width,
+        sleeve_round=args.sleeve_round,
     )
     if args.fit_height is not None:
         size = fitted_size(args.fit_height, size)

@@ -17,8 +17,9 @@ A kimono is cut from one bolt into straight rectangles. Seven pieces are made he
 - **sode_right, sode_left** (sleeves 袖): **one piece each**, `sleeve_width` wide and 2 x `sleeve_depth` long,
   folded at the top (the sleeve crease 袖山 at y = sleeve_depth, in line with the shoulder fold), as it is cut.
   Seams: the sleeve attachment (front and back halves to the migoro), the bottom (袖底: the two short ends), the
-  cuff side below the hand opening (袖口下, `sleeve_opening` left open from the crease down). The body side below
-  the attachment stays open (振り).
+  cuff side below the hand opening (袖口下, `sleeve_opening` left open from the crease down), and between those two
+  the rounded corner (袖の丸み, `sleeve_round`, a quarter circle: 2 cm on a standard or formal kimono, up to ~12 cm
+  on everyday ones). The body side below the attachment stays open (振り).
 - **eri** (collar 衿): a strip `collar_width` wide whose one long edge is sewn, left collar end to right collar end,
   along the okumi front edge, okumi top, neck diagonal and back neck of each side; its length is their sum.
 The over-collar (tomoeri 共衿) is left out: it is a second layer on the front part of the collar and adds no shape.
@@ -46,7 +47,7 @@ from dataclasses import asdict, dataclass, fields, replace
 import numpy as np
 
 from ..errors import InputError
-from ._types import EdgeRef, Fold, Pattern, Piece, Placement, Seam
+from ._types import Curve, EdgeRef, Fold, Pattern, Piece, Placement, Seam
 
 #: Allowed ranges, cm (a child's kimono to a tall adult's; furisode sleeves reach ~115 cm).
 RANGES = {
@@ -85,6 +86,7 @@ class KimonoSize:
     collar_width: float = 5.5  # 衿幅
     neck_width: float = 9.0  # 衿肩あき, centre to the neck point on the shoulder
     back_neck_drop: float = 2.0  # 繰越
+    sleeve_round: float = 2.0  # 袖の丸み, radius of the sleeve bag's rounded bottom corner at the cuff; 0: square
 
     def resolved(self) -> KimonoSize:
         """All derived values filled in, after checking every number; InputError names the bad option."""
@@ -140,6 +142,7 @@ class KimonoSize:
             self.collar_width,
             self.neck_width,
             self.back_neck_drop,
+            self.sleeve_round,
         )
         checks = [
             (
@@ -163,6 +166,12 @@ class KimonoSize:
             (2 <= self.collar_width <= self.bolt_width / 2, "collar_width", "must be 2 cm .. half the bolt width"),
             (2 <= self.neck_width <= self.shoulder - 5, "neck_width", "must be 2 cm .. the shoulder width - 5"),
             (0 <= self.back_neck_drop <= 8, "back_neck_drop", "must be 0..8 cm"),
+            (
+                0 <= self.sleeve_round <= min(15.0, sw / 2, d - hand - 1),
+                "sleeve_round",
+                f"must be 0..{min(15.0, sw / 2, d - hand - 1):g} cm (15 cm, half the sleeve width, and 1 cm short "
+                "of the hand opening)",
+            ),
         ]
         for ok, name, why in checks:
             if not ok:
@@ -204,8 +213,12 @@ def _opt(name: str) -> str:
     return "--" + name.replace("_", "-")
 
 
-def _piece(name: str, pts: list, edge_names: list[str], placement: Placement) -> tuple[Piece, dict[str, int]]:
-    return Piece(name, np.array(pts, dtype=np.float64), {}, False, placement), {n: i for i, n in enumerate(edge_names)}
+def _piece(
+    name: str, pts: list, edge_names: list[str], placement: Placement, curves: dict[str, Curve]
+) -> tuple[Piece, dict[str, int]]:
+    index = {n: i for i, n in enumerate(edge_names)}
+    piece = Piece(name, np.array(pts, dtype=np.float64), {index[n]: c for n, c in curves.items()}, False, placement)
+    return piece, index
 
 
 def make_kimono(
@@ -238,8 +251,8 @@ def make_kimono(
 
     pieces, edges = [], {}
 
-    def add(name, pts, names, placement):
-        piece, e = _piece(name, pts, names, placement)
+    def add(name, pts, names, placement, curves=None):
+        piece, e = _piece(name, pts, names, placement, curves or {})
         pieces.append(piece)
         edges[name] = e
 
@@ -321,41 +334,45 @@ def make_kimono(
         ["hem", "centre", "top", "front_collar", "front_free"],
         Placement([-O / 100.0, shoulder_y + lift - L / 100.0, zf + 0.015], [0, 0, 0]),
     )
-    # Sleeves: one folded piece each, crease at y = D on the shoulder fold; body side towards the body panel.
-    add(
-        "sode_right",
-        [(0, 0), (W, 0), (W, D - a), (W, D), (W, D + a), (W, 2 * D), (0, 2 * D), (0, D + c), (0, D), (0, D - c)],
-        [
-            "front_bottom",
-            "front_furi",
-            "front_attach",
-            "back_attach",
-            "back_furi",
-            "back_bottom",
-            "back_cuff_seam",
-            "back_opening",
-            "front_opening",
-            "front_cuff_seam",
-        ],
-        hang(-(K + W) / 100.0, D),
-    )
-    add(
-        "sode_left",
-        [(0, 0), (W, 0), (W, D - c), (W, D), (W, D + c), (W, 2 * D), (0, 2 * D), (0, D + a), (0, D), (0, D - a)],
-        [
-            "front_bottom",
-            "front_cuff_seam",
-            "front_opening",
-            "back_opening",
-            "back_cuff_seam",
-            "back_bottom",
-            "back_furi",
-            "back_attach",
-            "front_attach",
-            "front_furi",
-        ],
-        hang(K / 100.0, D),
-    )
+    # Sleeves: one folded piece each, crease at y = D on the shoulder fold; body side towards the body panel. The
+    # cuff side's two bottom corners (front and back half of the bag's corner) are rounded by R: a quarter circle
+    # that bulges out of the piece ("circle" curve: sagitta / chord = (1 - cos 45°) / (2 sin 45°)).
+    R = s.sleeve_round
+    arc = Curve("circle", [[0.5, -(1 - math.sqrt(0.5)) / (2 * math.sqrt(0.5))]])
+    right = [
+        ((0, 0), "front_bottom"),
+        ((W, 0), "front_furi"),
+        ((W, D - a), "front_attach"),
+        ((W, D), "back_attach"),
+        ((W, D + a), "back_furi"),
+        ((W, 2 * D), "back_bottom"),
+        ((0, 2 * D), "back_cuff_seam"),
+        ((0, D + c), "back_opening"),
+        ((0, D), "front_opening"),
+        ((0, D - c), "front_cuff_seam"),
+    ]
+    left = [
+        ((0, 0), "front_bottom"),
+        ((W, 0), "front_cuff_seam"),
+        ((W, D - c), "front_opening"),
+        ((W, D), "back_opening"),
+        ((W, D + c), "back_cuff_seam"),
+        ((W, 2 * D), "back_bottom"),
+        ((0, 2 * D), "back_furi"),
+        ((0, D + a), "back_attach"),
+        ((0, D), "front_attach"),
+        ((0, D - a), "front_furi"),
+    ]
+    if R > 0:
+        # Each square corner becomes an arc edge between two points R from it along its two edges.
+        right[0:1] = [((R, 0), "front_bottom")]
+        right[6:7] = [((R, 2 * D), "back_round"), ((0, 2 * D - R), "back_cuff_seam")]
+        right.append(((0, R), "front_round"))
+        left[5:6] = [((W, 2 * D - R), "back_round"), ((W - R, 2 * D), "back_bottom")]
+        left[1:2] = [((W - R, 0), "front_round"), ((W, R), "front_cuff_seam")]
+    for side, outline, x0 in (("right", right, -(K + W)), ("left", left, K)):
+        rounds = {"front_round": arc, "back_round": arc} if R > 0 else {}
+        add(f"sode_{side}", [p for p, _ in outline], [nm for _, nm in outline], hang(x0 / 100.0, D), rounds)
     # Collar: its bottom edge (y = 0), left collar end (x = 0) to right collar end, is sewn segment by segment.
     diag, bneck, upper = math.hypot(n, sd), math.hypot(n, k), H - E
     segs = [
@@ -402,6 +419,8 @@ def make_kimono(
             seam(sode, "front_bottom", sode, "back_bottom"),
             seam(sode, "front_cuff_seam", sode, "back_cuff_seam"),
         ]
+        if R > 0:
+            seams.append(seam(sode, "front_round", sode, "back_round"))
     for side in ("left", "right"):
         seams += [
             seam("eri", f"{side}_okumi_front", f"okumi_{side}", "front_collar"),
