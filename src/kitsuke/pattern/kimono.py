@@ -364,7 +364,8 @@ def make_kimono(
         ((0, D - a), "front_furi"),
     ]
     if R > 0:
-        # Each square corner becomes an arc edge between two points R from it along its two edges.
+        # Each square corner becomes an arc edge between two points R from it along its two edges. The later
+        # index of a list is spliced first, so the earlier one still names the original point.
         right[0:1] = [((R, 0), "front_bottom")]
         right[6:7] = [((R, 2 * D), "back_round"), ((0, 2 * D - R), "back_cuff_seam")]
         right.append(((0, R), "front_round"))
