@@ -224,3 +224,27 @@ def project_tethers(pos, tri, bary, movable, lines, line_of, reach):
         for k in range(3):
             pos[tri[i, k]] += bary[i, k] / (bary[i] @ bary[i]) * over / best * (q - p)
     return pos, worst
+
+
+def layer_moves(pos, faces, face_layer, vertex_layer, movable, reach, gap, max_step):
+    """`keep_layers`' moves (V, 3) by brute force: every vertex with a layer against every face of another layer
+    that does not hold it (`closest_on_mesh`), then the side rules of `_collide_kernels.layer_moves`."""
+    out = np.zeros_like(pos)
+    for v in np.flatnonzero((vertex_layer > 0) & movable):
+        mine = vertex_layer[v]
+        cand = np.flatnonzero((face_layer > 0) & (face_layer != mine) & ~(faces == v).any(axis=1))
+        if not len(cand):
+            continue
+        k, q, d = closest_on_mesh(pos[v], pos, faces[cand])
+        if d >= reach:
+            continue
+        a, b, c = pos[faces[cand[k]]]
+        n = unit(np.cross(b - a, c - a))
+        h = (pos[v] - q) @ n
+        if d * d - h * h > (0.5 * abs(h) + 1e-3) ** 2:  # beside the other layer's border
+            continue
+        s = 1.0 if mine > face_layer[cand[k]] else -1.0
+        short = gap - s * h
+        if short > 0:
+            out[v] = s * min(0.5 * short, max_step) * n
+    return out

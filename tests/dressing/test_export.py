@@ -123,6 +123,13 @@ def test_dress_a_kimono_pattern_like_the_demo(run_cli, tmp_path):
         if name.startswith("sode"):
             v = np.unique(g.faces[g.piece_faces[k, 0] : g.piece_faces[k, 1]])
             assert elbow - g.positions[v, 1].min() > 0.25, name
+    # The fronts' layers (left over right) travel in the OBJ's `# kitsuke layer` lines, for a later drag.
+    for k, name in enumerate(g.piece_names):
+        layer = g.face_layer[g.piece_faces[k, 0] : g.piece_faces[k, 1]]
+        if name.startswith("okumi"):
+            assert (layer == (2 if name.endswith("left") else 1)).all(), name
+        elif name.startswith("sode"):
+            assert not layer.any(), name
     summary = json.loads(report.read_text())
     assert summary["held_vertices"] > 100  # the obi band
     assert summary["quality"]["penetration_count"] == 0 and summary["quality"]["inverted_count"] == 0
@@ -133,3 +140,20 @@ def test_read_garment_obj_rejects_plain_meshes(tmp_path):
     p.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     with pytest.raises(InputError, match="needs a vt"):
         read_garment_obj(p)
+
+
+@pytest.mark.parametrize(
+    "line, text",
+    [
+        ("# kitsuke layer two 0 0", "bad layer line"),
+        ("# kitsuke layer 63 0 0", "layer 1..62"),
+        ("# kitsuke layer 1 0 5", "layer 1..62"),
+    ],
+    ids=["not-a-number", "too-high", "past-the-faces"],
+)
+def test_read_garment_obj_rejects_bad_layer_lines(tmp_path, line, text):
+    p = tmp_path / "g.obj"
+    p.write_text(f"{line}\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n")
+    with pytest.raises(InputError, match=text) as e:
+        read_garment_obj(p)
+    assert "g.obj" in str(e.value)

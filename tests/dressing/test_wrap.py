@@ -311,16 +311,18 @@ def test_shirt_on_mean_all_structure(shirt):
 # -- the kimono on the default body --------------------------------------------------------------------------------
 def test_kimono_on_default_body(body, dressed_kimono):
     """default_kimono() with the shipped strokes at 1.5 cm edges, its waist held in the obi band and its sleeves
-    hanging (what `kitsuke demo` dresses). Measured 2026-11-25 (stroke tethers at 8 mm, hang 2, sleeve corners
-    rounded 2 cm): no penetration, seams shared, no folded triangle, strain mean 0.47 % and max 41 % (stretched
-    edges where the collar turns round the body panel's neck point: 459° of pattern there), stroke residual
-    8.9 mm (targets: 1 % / 5 % / 10 mm: the max NOT met). With square sleeve corners: 0.52 % / 65 %, crushed
-    edges at a sleeve bag's bottom corner."""
+    hanging (what `kitsuke demo` dresses), its left front kept over the right. Measured 2026-11-25 (stroke
+    tethers at 8 mm, hang 2, sleeve corners rounded 2 cm, layers 2 mm apart): no penetration, seams shared, no
+    folded triangle, strain mean 0.55 % and max 51 % (a crease in the left side seam at the hem, where the left
+    front's side lies over the right front's edge; next, 46 %, the right collar where the collars cross),
+    stroke residual 8.9 mm (targets: 1 % / 5 % / 10 mm: the max NOT met). Before the layers: 0.47 % / 41 % (the
+    worst edge where the collar turns round the body panel's neck point, 459° of pattern there), with the fronts
+    through each other; with square sleeve corners: 0.52 % / 65 %."""
     g = dressed_kimono
     r = g.report
     assert r.penetration_count == 0 and r.seam_gap_mm == 0.0
-    assert r.strain_mean < 0.01  # measured 0.0047
-    assert r.strain_max < 0.5  # measured 0.415
+    assert r.strain_mean < 0.01  # measured 0.0055
+    assert r.strain_max < 0.6  # measured 0.507
     assert r.inverted_count == 0
     assert g.max_stroke_residual_m <= 0.01  # measured 0.0088: issue 3's target
     _, counts = edge_topology(g.faces)
@@ -338,6 +340,37 @@ def test_kimono_on_default_body(body, dressed_kimono):
         if name.startswith("sode"):
             sleeves[g.faces[g.piece_faces[k, 0] : g.piece_faces[k, 1]].reshape(-1)] = True
     assert not (g.pinned & sleeves).any()
+
+
+def wrong_side_mm(g, mine: int, other: int) -> np.ndarray:
+    """Millimetres by which each vertex of layer `mine` lying over or under a face of layer `other` (within 3 cm,
+    not off to the side of its border) is on the wrong side of it (0 where it is on the right side)."""
+    import igl
+
+    m = g.model
+    q = np.flatnonzero(m.vertex_layer == mine)
+    faces = g.faces[m.face_layer == other]
+    d2, fi, cp = igl.point_mesh_squared_distance(g.positions[q], g.positions, faces)
+    tri = g.positions[faces[fi]]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    h = np.einsum("ij,ij->i", g.positions[q] - cp, n)
+    between = (d2 < 0.03**2) & (d2 - h * h < (0.5 * np.abs(h) + 1e-3) ** 2)
+    wrong = -h if mine > other else h
+    return np.where(between, np.maximum(wrong, 0.0), 0.0) * 1e3
+
+
+def test_kimono_left_front_lies_over_the_right(dressed_kimono):
+    """SPEC §5.4: left over right. The left front (okumi, body panel front, collar end: layer 2) stays outside
+    the right one (layer 1) through the wrap. Measured 2026-11-25: of ~1480 right-front vertices under the left
+    front, 0 more than 1.5 mm outside it; of the left front's, 4 more than 2 mm inside the right front, the
+    deepest 6.4 mm (where the collars cross at the chest). Without the layers: 370 right-front vertices outside
+    the left front, up to 3 cm."""
+    g = dressed_kimono
+    under = wrong_side_mm(g, 1, 2)
+    over = wrong_side_mm(g, 2, 1)
+    assert (under > 1.5).sum() == 0
+    assert (over > 2.0).sum() <= 10 and over.max() < 10.0
 
 
 def test_kimono_sleeves_hang_below_the_arms(body, dressed_kimono):

@@ -12,7 +12,7 @@ Typical use::
 small move down, and collision pushes the cloth out of the body. Constants live in `ClothParams`.
 """
 
-from ._collide import BodyCollider, CollisionStats, collide, track, vertex_active
+from ._collide import BodyCollider, CollisionStats, collide, keep_layers, track, vertex_active
 from ._lengths import LengthStats, restore_lengths
 from ._model import ClothModel, ClothParams, ClothState, Contacts, locality_order
 from ._relax import RelaxStats, relax
@@ -36,6 +36,7 @@ __all__ = [
     "collide",
     "folded_faces",
     "grow_region",
+    "keep_layers",
     "colliding_edges",
     "grid_sheet",
     "grid_tube",

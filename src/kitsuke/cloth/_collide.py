@@ -283,10 +283,68 @@ def track(model: ClothModel, state: ClothState, collider: BodyCollider, *, activ
     return len(idx)
 
 
+def _layer_face_vertices(model: ClothModel, state: ClothState) -> np.ndarray:
+    """The vertices of the active faces that have a layer (cached on the state while face_active is unchanged)."""
+    w = state._work
+    key = state.face_active.tobytes()
+    if w.get("layer_face_vertices_key") != key:
+        on = state.face_active[model.layer_faces]
+        lv = model.layer_face_vertices if on.all() else np.unique(model.faces[model.layer_faces[on]])
+        w["layer_face_vertices"], w["layer_face_vertices_key"] = lv, key
+    return w["layer_face_vertices"]
+
+
+def keep_layers(model: ClothModel, state: ClothState, movable: np.ndarray | None = None) -> int:
+    """Restore the order of the model's cloth layers (`ClothModel.face_layer`; in place): each movable vertex of
+    one layer within `params.layer_reach_m` of an active face of another moves towards its side of that face, so
+    that the higher layer lies `params.layer_gap_m` outside the lower one (a Jacobi step: every vertex takes half
+    its shortfall, the other layer's vertices the other half). Returns the number of vertices moved (0 for a
+    model without layers)."""
+    if model.face_layer is None:
+        return 0
+    p = model.params
+    act = vertex_active(model, state)
+    if movable is None:
+        movable = act & ~state.pinned
+    query = model.layer_vertices[movable[model.layer_vertices]]
+    if len(query) == 0:
+        return 0
+    others = _layer_face_vertices(model, state)
+    pos = state.positions
+    if len(others) == 0:
+        return 0
+    origin, cell, dims, ptr, items = K.point_grid(pos, others, model.layer_cell_m, 8 * len(others))
+    move = np.empty((len(query), 3))
+    moved = K.layer_moves(
+        pos,
+        model.faces,
+        model.face_layer,
+        state.face_active,
+        model.vertex_layer,
+        model.layers_at,
+        model.vertex_corners_ptr,
+        model.vertex_corners,
+        query,
+        origin,
+        cell,
+        dims,
+        ptr,
+        items,
+        pos[items],
+        p.layer_reach_m,
+        p.layer_gap_m,
+        p.max_step_m,
+        move,
+    )
+    pos[query] += move
+    return int(moved)
+
+
 def collide(model: ClothModel, state: ClothState, collider: BodyCollider) -> CollisionStats:
-    """One collision update (in place): capsules push vertices, then edges, out; the nearest body points are
-    tracked; vertices closer than `params.contact_offset_m` (or inside) move out along the body normal.
-    Pinned vertices and vertices without an active triangle never move.
+    """One collision update (in place): layered cloth restores its layer order (`keep_layers`); capsules push
+    vertices, then edges, out; the nearest body points are tracked; vertices closer than
+    `params.contact_offset_m` (or inside) move out along the body normal. Pinned vertices and vertices without an
+    active triangle never move.
     """
     if not isinstance(collider, BodyCollider):
         raise InputError("collider must be a BodyCollider")
@@ -296,6 +354,8 @@ def collide(model: ClothModel, state: ClothState, collider: BodyCollider) -> Col
     w = _buffers(state)
     movable = np.logical_and(act, ~state.pinned, out=w["movable"])
     pos = state.positions
+    # Layers first: an inner layer pushed into the body comes back out below, and the outer one follows next time.
+    keep_layers(model, state, movable)
     if len(collider.capsule_ends):
         lo, hi = collider._capsule_box
         margin = float(model.rest_lengths.max()) * 1.5  # an edge's far end can be this far from a capsule it cuts

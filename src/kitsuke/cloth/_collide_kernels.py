@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import os
 
+import numpy as np
 from numba import njit, prange
 
 PARALLEL = os.environ.get("KITSUKE_NUMBA_PARALLEL", "1") != "0"
@@ -437,8 +438,158 @@ def capsule_edges(pos, edges, movable, ends, radii, near):
             c += 1
 
 
+@njit(cache=True)
+def point_grid(pos, ids, cell, max_cells):
+    """A uniform grid of the points `ids` (G,): (origin (3,), cell size, dims (3,) int64, ptr (C + 1,), items (G,)
+    int64 point ids by cell). The cell size doubles from `cell` until the grid has at most `max_cells` cells."""
+    lo = np.full(3, np.inf)
+    hi = np.full(3, -np.inf)
+    for i in range(ids.shape[0]):
+        for a in range(3):
+            lo[a] = min(lo[a], pos[ids[i], a])
+            hi[a] = max(hi[a], pos[ids[i], a])
+    dims = np.ones(3, dtype=np.int64)
+    if ids.shape[0] == 0:
+        return lo, cell, dims, np.zeros(2, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    while True:
+        for a in range(3):
+            dims[a] = int((hi[a] - lo[a]) / cell) + 1
+        if dims[0] * dims[1] * dims[2] <= max_cells:
+            break
+        cell *= 2.0
+    n_cells = dims[0] * dims[1] * dims[2]
+    key = np.empty(ids.shape[0], dtype=np.int64)
+    ptr = np.zeros(n_cells + 1, dtype=np.int64)
+    for i in range(ids.shape[0]):
+        x = min(int((pos[ids[i], 0] - lo[0]) / cell), dims[0] - 1)
+        y = min(int((pos[ids[i], 1] - lo[1]) / cell), dims[1] - 1)
+        z = min(int((pos[ids[i], 2] - lo[2]) / cell), dims[2] - 1)
+        key[i] = (x * dims[1] + y) * dims[2] + z
+        ptr[key[i] + 1] += 1
+    for c in range(n_cells):
+        ptr[c + 1] += ptr[c]
+    fill = ptr[:-1].copy()
+    items = np.empty(ids.shape[0], dtype=np.int64)
+    for i in range(ids.shape[0]):
+        items[fill[key[i]]] = ids[i]
+        fill[key[i]] += 1
+    return lo, cell, dims, ptr, items
+
+
+@njit(cache=True, parallel=PARALLEL)
+def layer_moves(
+    pos,
+    faces,
+    face_layer,
+    face_active,
+    vertex_layer,
+    layers_at,
+    corners_ptr,
+    corners,
+    query,
+    origin,
+    cell,
+    dims,
+    ptr,
+    items,
+    grid_pos,
+    reach,
+    gap,
+    max_step,
+    out,
+):
+    """Moves (Q, 3) into `out` that restore the order of cloth layers at the vertices `query` (Q,): a vertex of
+    layer a nearest (within `reach`) to a face of another layer b must lie at least `gap` outside that face
+    (along its normal, the winding's outer side) where a > b, and `gap` inside it where a < b. A vertex that
+    violates this takes half the shortfall (the other layer's vertices take the other half in their own query),
+    at most `max_step`. Points beside the other layer's border (nearest point on its boundary, off to the side
+    by more than half their height over it plus 1 mm) are not between the layers and are left alone.
+
+    The nearest face is searched among the faces around the nearest vertex that lies on a face of another layer
+    (and the next two nearest where the nearest point found lies on the rim of that fan). Grid (`items`, cells of
+    at least `reach` plus most of an edge; grid_pos: their positions in grid order); `layers_at`: bit l set where
+    a vertex has a face of layer l; inactive faces are skipped; corners_ptr, corners: CSR of the corners
+    (face * 3 + k) at each vertex.
+    Returns the number of vertices moved."""
+    moved = 0
+    for qi in prange(query.shape[0]):
+        out[qi, 0] = out[qi, 1] = out[qi, 2] = 0.0
+        v = query[qi]
+        lv = vertex_layer[v]
+        px, py, pz = pos[v, 0], pos[v, 1], pos[v, 2]
+        cx = int(math.floor((px - origin[0]) / cell))
+        cy = int(math.floor((py - origin[1]) / cell))
+        cz = int(math.floor((pz - origin[2]) / cell))
+        # The three nearest candidates, nearest first (scalars: an array per vertex costs an allocation).
+        c0 = c1 = c2 = -1
+        d0 = d1 = d2 = cell * cell
+        bit = np.int64(1) << lv
+        for x in range(max(cx - 1, 0), min(cx + 2, dims[0])):
+            for y in range(max(cy - 1, 0), min(cy + 2, dims[1])):
+                # The z cells of one (x, y) are consecutive: one run of items.
+                c = (x * dims[1] + y) * dims[2]
+                for j in range(ptr[c + max(cz - 1, 0)], ptr[c + min(cz + 2, dims[2])]):
+                    u = items[j]
+                    if layers_at[u] & ~bit == 0:
+                        continue
+                    d = (px - grid_pos[j, 0]) ** 2 + (py - grid_pos[j, 1]) ** 2 + (pz - grid_pos[j, 2]) ** 2
+                    if d >= d2:
+                        continue
+                    if d < d0:
+                        c2, d2, c1, d1, c0, d0 = c1, d1, c0, d0, u, d
+                    elif d < d1:
+                        c2, d2, c1, d1 = c1, d1, u, d
+                    else:
+                        c2, d2 = u, d
+        best = reach * reach
+        bf = -1
+        bqx = bqy = bqz = 0.0
+        for k in range(3):
+            u = c0 if k == 0 else (c1 if k == 1 else c2)
+            if u < 0:
+                break
+            fan_edge = False  # the best point so far lies on the far rim of u's fan: the next candidate may beat it
+            for j in range(corners_ptr[u], corners_ptr[u + 1]):
+                f = corners[j] // 3
+                i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
+                if face_layer[f] == 0 or face_layer[f] == lv or not face_active[f] or i0 == v or i1 == v or i2 == v:
+                    continue
+                qx, qy, qz, _, _, _, region = closest_on_triangle(px, py, pz, pos, i0, i1, i2)
+                dq = (px - qx) ** 2 + (py - qy) ** 2 + (pz - qz) ** 2
+                if dq < best:
+                    best, bf, bqx, bqy, bqz = dq, f, qx, qy, qz
+                    # Corner u is corners[j] % 3; the rim is the edge opposite it and its two far corners.
+                    ku = corners[j] % 3
+                    rim_edge = 4 + (ku + 1) % 3  # edge codes 4, 5, 6: edges 01, 12, 20
+                    fan_edge = region == rim_edge or (1 <= region <= 3 and region - 1 != ku)
+            if bf >= 0 and not fan_edge:
+                break
+        if bf < 0:
+            continue
+        i0, i1, i2 = faces[bf, 0], faces[bf, 1], faces[bf, 2]
+        ax, ay, az = pos[i1, 0] - pos[i0, 0], pos[i1, 1] - pos[i0, 1], pos[i1, 2] - pos[i0, 2]
+        bx, by, bz = pos[i2, 0] - pos[i0, 0], pos[i2, 1] - pos[i0, 1], pos[i2, 2] - pos[i0, 2]
+        nx, ny, nz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+        nn = math.sqrt(nx * nx + ny * ny + nz * nz)
+        if nn <= 1e-20:
+            continue
+        nx, ny, nz = nx / nn, ny / nn, nz / nn
+        h = (px - bqx) * nx + (py - bqy) * ny + (pz - bqz) * nz
+        side = max(best - h * h, 0.0)
+        if side > (0.5 * abs(h) + 1e-3) ** 2:
+            continue
+        s = 1.0 if lv > face_layer[bf] else -1.0
+        short = gap - s * h
+        if short <= 0.0:
+            continue
+        m = s * min(0.5 * short, max_step)
+        out[qi, 0], out[qi, 1], out[qi, 2] = m * nx, m * ny, m * nz
+        moved += 1
+    return moved
+
+
 def set_parallel(parallel: bool) -> None:
     """Recompile the per-vertex kernels with or without threads (for benchmarks; not cached)."""
     g = globals()
-    for name in ("walk_track", "push_out", "capsule_vertices"):
+    for name in ("walk_track", "push_out", "capsule_vertices", "layer_moves"):
         g[name] = njit(parallel=parallel)(g[name].py_func)

@@ -61,6 +61,12 @@ class ClothParams:
     walk_max_steps: int = 64
     #: Push cloth edges (not only vertices) out of the body's capsules ("bones").
     edge_capsules: bool = True
+    #: Layered cloth (`ClothModel.face_layer`): the distance kept between two layers, metres (a kimono's silk is
+    #: ~0.3 mm thick; 2 mm keeps the outer layer's triangles clear of the inner one's vertices between them).
+    layer_gap_m: float = 0.002
+    #: Layered cloth: a vertex this close (metres) to another layer's face keeps the order against it. Farther
+    #: apart, nothing is known about which layer is where (a kimono's two fronts hang apart below the obi).
+    layer_reach_m: float = 0.02
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -77,6 +83,10 @@ class ClothParams:
             raise InputError(f"cloth parameter support_normal_y must be in [-1, 1], got {self.support_normal_y}")
         if self.walk_max_steps < 1:
             raise InputError("cloth parameter walk_max_steps must be >= 1")
+
+
+#: Highest cloth layer (`ClothModel.face_layer`; a vertex's layers are bits of an int64).
+MAX_LAYER = 62
 
 
 def _csr(keys: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -115,12 +125,20 @@ class ClothModel:
         edge joining them.
     boundary_vertices : (V,) bool, on a boundary edge.
     params : ClothParams.
+    face_layer : (F,) int8 (0..MAX_LAYER) or None: layered cloth (SPEC §5.4, a kimono's left front over its
+        right). 0 for faces outside any layer; where faces of two different layers meet, the higher layer is kept
+        outside the lower one (`collide`).
+    vertex_layer : (V,) int8, a vertex's layer where all its faces share one, else 0.
+        layer_faces, layer_vertices : int64 indices of the faces and vertices with a layer (empty without);
+        layer_face_vertices : the vertices of layer_faces; layers_at : (V,) int64, bit l set where a vertex has
+        a face of layer l; layer_cell_m : the grid cell of `keep_layers`, metres.
     """
 
     faces: np.ndarray
     rest_corners: np.ndarray
     params: ClothParams = field(default_factory=ClothParams)
     n_vertices: int = 0
+    face_layer: np.ndarray | None = None
     rest_areas: np.ndarray = field(init=False, repr=False)
     edges: np.ndarray = field(init=False, repr=False)
     rest_lengths: np.ndarray = field(init=False, repr=False)
@@ -138,6 +156,12 @@ class ClothModel:
     adjacency: np.ndarray = field(init=False, repr=False)
     adjacency_edge: np.ndarray = field(init=False, repr=False)
     boundary_vertices: np.ndarray = field(init=False, repr=False)
+    vertex_layer: np.ndarray = field(init=False, repr=False)
+    layer_faces: np.ndarray = field(init=False, repr=False)
+    layer_vertices: np.ndarray = field(init=False, repr=False)
+    layer_face_vertices: np.ndarray = field(init=False, repr=False)
+    layers_at: np.ndarray = field(init=False, repr=False)
+    layer_cell_m: float = field(init=False, repr=False)
 
     @classmethod
     def from_corners(
@@ -147,10 +171,12 @@ class ClothModel:
         *,
         n_vertices: int | None = None,
         params: ClothParams | None = None,
+        face_layer: np.ndarray | None = None,
     ) -> ClothModel:
         """Model from faces (F, 3) and per-corner pattern positions (F, 3, 2) in metres.
 
         n_vertices : number of vertices (default: the largest index + 1).
+        face_layer : (F,) integers 0..127 or None, see the class docstring.
         Raises InputError for malformed arrays, a degenerate rest triangle or a non-manifold edge.
         """
         faces = _as_faces(faces)
@@ -162,7 +188,7 @@ class ClothModel:
         n = int(faces.max()) + 1 if n_vertices is None else int(n_vertices)
         if n <= faces.max():
             raise InputError(f"a face refers to vertex {int(faces.max())} but there are {n} vertices")
-        return cls(faces, np.ascontiguousarray(rc), params or ClothParams(), n)
+        return cls(faces, np.ascontiguousarray(rc), params or ClothParams(), n, face_layer)
 
     @classmethod
     def from_flat(cls, faces: np.ndarray, rest_uv: np.ndarray, *, params: ClothParams | None = None) -> ClothModel:
@@ -259,6 +285,35 @@ class ClothModel:
         self.adjacency_edge = np.ascontiguousarray(np.concatenate([np.arange(ne), np.arange(ne)])[idx])
         self.boundary_vertices = np.zeros(nv, dtype=bool)
         self.boundary_vertices[edges[~two].reshape(-1)] = True
+        self._layers()
+
+    def _layers(self) -> None:
+        nf, nv = len(self.faces), self.n_vertices
+        self.vertex_layer = np.zeros(nv, dtype=np.int8)
+        if self.face_layer is None or not np.any(self.face_layer):
+            self.face_layer = None
+            self.layer_faces = self.layer_vertices = self.layer_face_vertices = np.zeros(0, dtype=np.int64)
+            self.layers_at = np.zeros(nv, dtype=np.int64)
+            self.layer_cell_m = 0.0
+            return
+        fl = np.asarray(self.face_layer)
+        if fl.shape != (nf,) or not np.issubdtype(fl.dtype, np.integer) or fl.min() < 0 or fl.max() > MAX_LAYER:
+            raise InputError(f"face_layer must be ({nf},) integers in 0..{MAX_LAYER}, got {fl.shape} {fl.dtype}")
+        self.face_layer = np.ascontiguousarray(fl, dtype=np.int8)
+        corner_layer = np.repeat(self.face_layer.astype(np.int64), 3)
+        lo = np.full(nv, MAX_LAYER + 1, dtype=np.int64)
+        hi = np.zeros(nv, dtype=np.int64)
+        np.minimum.at(lo, self.faces.reshape(-1), corner_layer)
+        np.maximum.at(hi, self.faces.reshape(-1), corner_layer)
+        self.vertex_layer[lo == hi] = hi[lo == hi]
+        self.layer_faces = np.flatnonzero(self.face_layer)
+        self.layer_vertices = np.flatnonzero(self.vertex_layer)
+        self.layers_at = np.zeros(nv, dtype=np.int64)
+        np.bitwise_or.at(self.layers_at, self.faces.reshape(-1), np.left_shift(1, corner_layer) * (corner_layer > 0))
+        self.layer_face_vertices = np.unique(self.faces[self.layer_faces])
+        # Grid cells for `keep_layers`: the nearest point of a face within reach has a corner within reach plus
+        # most of an edge.
+        self.layer_cell_m = self.params.layer_reach_m + 0.6 * float(np.median(self.rest_lengths))
 
     @property
     def n_faces(self) -> int:
@@ -270,7 +325,7 @@ class ClothModel:
 
     def with_params(self, params: ClothParams) -> ClothModel:
         """The same cloth with other parameters (topology is rebuilt; cheap next to a relaxation)."""
-        return ClothModel(self.faces, self.rest_corners, params, self.n_vertices)
+        return ClothModel(self.faces, self.rest_corners, params, self.n_vertices, self.face_layer)
 
 
 def _as_faces(faces: np.ndarray) -> np.ndarray:

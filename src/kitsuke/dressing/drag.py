@@ -248,7 +248,7 @@ class DragSession:
         f = self._file
         try:
             self.model = ClothModel.from_corners(
-                f.faces, f.corner_uv, n_vertices=len(f.positions), params=self.params.cloth
+                f.faces, f.corner_uv, n_vertices=len(f.positions), params=self.params.cloth, face_layer=f.face_layer
             )
             self.state = ClothState.new(self.model, f.positions)
         except InputError as e:
@@ -280,7 +280,7 @@ class DragSession:
     def garment(self) -> GarmentFile:
         """The garment now (positions copied), for `write_garment_obj` / `write_garment_png`."""
         f = self._file
-        return GarmentFile(self.state.positions.copy(), f.faces, f.corner_uv, f.piece_names, f.piece_faces, f.name)
+        return dataclasses.replace(f, positions=self.state.positions.copy())
 
     def report(self) -> QualityReport:
         """The SPEC §6 quality report of the garment now against the body."""

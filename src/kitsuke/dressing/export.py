@@ -2,7 +2,8 @@
 
 OBJ: `v` world positions (metres); `vt` = each corner's pattern position in metres, piece-local, not normalised (so
 rest lengths can be recovered); `f v/vt`; seam vertices shared (one `v`, a `vt` per side); one comment line
-`# kitsuke piece <name> <first_face> <last_face>` per piece (faces counted from 0, last included).
+`# kitsuke piece <name> <first_face> <last_face>` per piece (faces counted from 0, last included); for layered cloth
+(a kimono's fronts) one line `# kitsuke layer <layer> <first_face> <last_face>` per run of faces on a layer above 0.
 GLB: the same surface split where its UVs differ, UVs normalised to the texture tile, double-sided material,
 optionally the body as a second mesh.
 """
@@ -17,11 +18,13 @@ from pathlib import Path
 import numpy as np
 
 from .._files import write_json_atomic, write_text_atomic
+from ..cloth._model import MAX_LAYER
 from ..errors import InputError
 from ..geometry import TriMesh, save_mesh
 from .wrap import DressedGarment
 
 PIECE_TAG = "kitsuke piece"
+LAYER_TAG = "kitsuke layer"
 NAME_TAG = "kitsuke dressed garment"
 
 
@@ -32,6 +35,7 @@ class GarmentFile:
     positions : (V, 3) float64 m. faces : (F, 3) int64. corner_uv : (F, 3, 2) float64, pattern metres.
     piece_names : (P,) names. piece_faces : (P, 2) int64 [start, stop) face ranges.
     name : the garment's name (from the file's `# kitsuke dressed garment <name>` line; "garment" without one).
+    face_layer : (F,) int8 cloth layer of each face (`kitsuke.cloth.ClothModel.face_layer`), or None.
     The writers below take a GarmentFile as well as a DressedGarment (a dragged garment is written this way).
     """
 
@@ -41,6 +45,7 @@ class GarmentFile:
     piece_names: list[str]
     piece_faces: np.ndarray
     name: str = "garment"
+    face_layer: np.ndarray | None = None
 
     @property
     def rest_edge_lengths(self) -> np.ndarray:
@@ -55,6 +60,12 @@ def garment_obj_text(garment: DressedGarment | GarmentFile) -> str:
     out.write(f"# {NAME_TAG} {garment.name}\n# v: world metres (Y up); vt: pattern metres, piece-local\n")
     for name, (a, b) in zip(garment.piece_names, garment.piece_faces, strict=True):
         out.write(f"# {PIECE_TAG} {name} {int(a)} {int(b) - 1}\n")
+    layer = _face_layer(garment)
+    if layer is not None:
+        cut = np.flatnonzero(np.diff(layer)) + 1
+        for a, b in zip(np.r_[0, cut], np.r_[cut, len(layer)], strict=True):
+            if layer[a]:
+                out.write(f"# {LAYER_TAG} {int(layer[a])} {int(a)} {int(b) - 1}\n")
     np.savetxt(out, garment.positions, fmt="v %.7f %.7f %.7f")
     np.savetxt(out, garment.corner_uv.reshape(-1, 2), fmt="vt %.7f %.7f")
     f = garment.faces + 1
@@ -81,6 +92,7 @@ def read_garment_obj(path: str | os.PathLike[str]) -> GarmentFile:
     if not (np.isfinite(data.vertices).all() and np.isfinite(data.uv).all()):
         raise InputError("holds NaN or infinite coordinates", path)
     names, ranges, garment_name = [], [], "garment"
+    layer = np.zeros(len(data.faces), dtype=np.int8)
     for line in data.comments:
         if line.startswith(NAME_TAG + " ") and line[len(NAME_TAG) + 1 :].strip():
             garment_name = line[len(NAME_TAG) + 1 :].strip()
@@ -91,12 +103,32 @@ def read_garment_obj(path: str | os.PathLike[str]) -> GarmentFile:
                 ranges.append((int(first), int(last) + 1))
             except ValueError:
                 raise InputError(f"bad piece line {line!r}", path) from None
+        elif line.startswith(LAYER_TAG + " "):
+            try:
+                value, first, last = (int(v) for v in line[len(LAYER_TAG) + 1 :].split())
+            except ValueError:
+                raise InputError(f"bad layer line {line!r}", path) from None
+            if not (1 <= value <= MAX_LAYER and 0 <= first <= last < len(data.faces)):
+                raise InputError(f"layer line {line!r}: layer 1..{MAX_LAYER} over faces the file has", path)
+            layer[first : last + 1] = value
     if not names:
         names, ranges = ["garment"], [(0, len(data.faces))]
     piece_faces = np.array(ranges, dtype=np.int64)
     if piece_faces.min() < 0 or piece_faces.max() > len(data.faces):
         raise InputError("a piece line names faces the file does not have", path)
-    return GarmentFile(data.vertices, data.faces, data.uv[data.face_uv], names, piece_faces, garment_name)
+    return GarmentFile(
+        data.vertices,
+        data.faces,
+        data.uv[data.face_uv],
+        names,
+        piece_faces,
+        garment_name,
+        layer if layer.any() else None,
+    )
+
+
+def _face_layer(garment: DressedGarment | GarmentFile) -> np.ndarray | None:
+    return garment.model.face_layer if isinstance(garment, DressedGarment) else garment.face_layer
 
 
 def garment_glb_mesh(
@@ -157,5 +189,6 @@ def as_garment_file(garment: DressedGarment | GarmentFile) -> GarmentFile:
             list(garment.piece_names),
             garment.piece_faces,
             garment.name,
+            garment.model.face_layer,
         )
     raise InputError("garment must be a DressedGarment or a GarmentFile (read_garment_obj)")

@@ -188,7 +188,9 @@ def rewrap(
     mesh = body if isinstance(body, TriMesh) else body.mesh
     if collider is None:
         collider = BodyCollider.from_mesh(mesh) if isinstance(body, TriMesh) else BodyCollider.from_body(body)
-    model = ClothModel.from_corners(g.faces, g.corner_uv, n_vertices=len(g.positions), params=p.cloth)
+    model = ClothModel.from_corners(
+        g.faces, g.corner_uv, n_vertices=len(g.positions), params=p.cloth, face_layer=g.face_layer
+    )
     pinned = snap_pins(g, pins, source=src)
     if pinned.all():
         raise InputError("every garment vertex is pinned: nothing can move", src)

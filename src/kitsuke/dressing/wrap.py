@@ -47,7 +47,7 @@ from ..errors import InputError
 from ..geometry import TriMesh
 from ..geometry.surface import Surface
 from ..metrics import QualityReport, quality_report
-from ..pattern import Pattern, PatternMesh, mesh_pattern
+from ..pattern import Pattern, PatternMesh, face_layers, mesh_pattern
 from ._grow import grow
 from ._mend import MendStats, mend_tears
 from ._place import StrokeTrack, place_strokes
@@ -408,7 +408,10 @@ def wrap(
     welded = weld(pm)
     placement = place_strokes(pm, welded, strokes, surface, collider, lift_m=p.lift_m)
     grow_params = dataclasses.replace(p.cloth, gravity_step_m=0.0)
-    model = ClothModel.from_corners(welded.faces, welded.rest_corners, n_vertices=welded.n_vertices, params=grow_params)
+    layer = face_layers(pm.layers, pm.piece_names, welded.piece_faces, welded.rest_corners * 100.0)
+    model = ClothModel.from_corners(
+        welded.faces, welded.rest_corners, n_vertices=welded.n_vertices, params=grow_params, face_layer=layer
+    )
     state = ClothState.new(model, placement.positions, pinned=placement.placed.copy(), face_active=placement.seed_faces)
     seed_pins = placement.placed.copy()
     t3 = time.perf_counter()
@@ -534,7 +537,11 @@ def wrap(
     t_finished = time.perf_counter()
     timings["finish"] = t_finished - t_settled
     if p.untangle_rounds:
+        # Without gravity, like the length restoration: the band is let go here too (a fold the sweeps left in it,
+        # where the kimono's layers lie pressed on each other, could not open otherwise).
+        state.pinned = unheld
         untangle(settle, state, collider, rounds=p.untangle_rounds, bend_stiffness=p.untangle_bend, tethers=tethers)
+        state.pinned = pins
     t6 = time.perf_counter()
     timings["untangle"] = t6 - t_finished
     timings["wrap"] = t6 - t0

@@ -16,6 +16,7 @@ from ._draw import pattern_sheet, sheet_to_png, sheet_to_svg
 from ._garmentcode import decide_reversed, garmentcode_from_dict, read_garmentcode
 from ._io import load_pattern, load_pattern_with_issues, render_pattern_png, render_pattern_svg, save_pattern
 from ._kitsuke_json import pattern_from_dict, pattern_to_dict, read_kitsuke, write_kitsuke
+from ._layers import LayerRegion, face_layers, pattern_layers
 from ._mesh import PatternMesh, mesh_pattern, mesh_quality, obj_text, write_pattern_obj
 from ._svg_import import read_svg
 from ._types import Curve, CurveType, EdgeRef, Fold, Pattern, Piece, Placement, Seam
@@ -32,6 +33,7 @@ __all__ = [
     "Fold",
     "Issue",
     "KimonoSize",
+    "LayerRegion",
     "Pattern",
     "PatternMesh",
     "Piece",
@@ -39,6 +41,7 @@ __all__ = [
     "Seam",
     "check_pattern",
     "decide_reversed",
+    "face_layers",
     "garmentcode_from_dict",
     "kimono_texture",
     "load_pattern",
@@ -50,6 +53,7 @@ __all__ = [
     "mesh_quality",
     "obj_text",
     "pattern_from_dict",
+    "pattern_layers",
     "pattern_sheet",
     "pattern_to_dict",
     "read_garmentcode",

@@ -25,6 +25,7 @@ import numpy as np
 
 from .._files import write_text_atomic
 from ..errors import InputError
+from ._layers import LayerRegion, pattern_layers
 from ._types import EdgeRef, Pattern
 from ._validate import check_pattern
 
@@ -53,6 +54,7 @@ class PatternMesh:
     seam_vertices : one (k, 2) int64 array per pattern seam: vertex pairs sewn together (a side, b side).
     placed : (P,) bool, whether each piece had a placement hint.
     edge_length_cm : the target edge length, cm.
+    layers : the pattern's cloth layers (`meta["layers"]`, see `_layers`), if any.
     """
 
     name: str
@@ -67,6 +69,7 @@ class PatternMesh:
     seam_vertices: list[np.ndarray] = field(repr=False)
     placed: np.ndarray = field(repr=False)
     edge_length_cm: float = 1.5
+    layers: tuple[LayerRegion, ...] = ()
 
     @property
     def n_vertices(self) -> int:
@@ -258,6 +261,7 @@ def mesh_pattern(pattern: Pattern, *, edge_length: float = 1.5, min_angle: float
         seam_vertices,
         placed,
         h,
+        pattern_layers(pattern.meta, pattern.piece_names),
     )
 
 

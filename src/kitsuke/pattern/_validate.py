@@ -4,7 +4,8 @@ Errors — a loader refuses the file (InputError naming it) and `validate` lists
   no-pieces, duplicate-name, zero-length-edge (two equal consecutive outline points), zero-area,
   self-intersection (the outline, curves included, crosses or touches itself), clockwise (the outline must run
   counter-clockwise seen from the outer face; reverse it or set `flipped`), unknown-piece, unknown-edge,
-  seam-self (an edge sewn to itself), edge-in-two-seams (a seam joins whole edges; split the edge instead).
+  seam-self (an edge sewn to itself), edge-in-two-seams (a seam joins whole edges; split the edge instead),
+  bad-layers (a malformed `meta["layers"]`, see `_layers`).
 Warnings — reported, the pattern loads and meshes:
   length-mismatch (a seam's two edges differ by more than 1 % of the longer one: sewing would stretch or ease
   the cloth; meshing still gives both sides the same number of vertices).
@@ -21,6 +22,7 @@ import numpy as np
 
 from ..errors import InputError
 from . import _geometry as geo
+from ._layers import pattern_layers
 from ._types import EdgeRef, Pattern
 
 #: Relative length difference above which a seam is reported.
@@ -155,6 +157,10 @@ def validate(pattern: Pattern) -> list[Issue]:
                     s,
                 )
             )
+    try:
+        pattern_layers(pattern.meta, pattern.piece_names)
+    except InputError as e:
+        issues.append(Issue("error", "bad-layers", e.message))
     return issues
 
 

@@ -25,7 +25,8 @@ A kimono is cut from one bolt into straight rectangles. Seven pieces are made he
 The over-collar (tomoeri 共衿) is left out: it is a second layer on the front part of the collar and adds no shape.
 
 The fronts: the wearer's left front goes over the right (left over right), so in the placement hint the left okumi
-sits 1 cm in front of the right one.
+sits 1 cm in front of the right one, and `meta["layers"]` puts the left okumi, the left body panel's front and the
+collar's left crossing part on layer 2 over their right counterparts on layer 1 (kept apart in the wrap).
 
 Every seam joins two edges of equal length (outlines are split where a seam covers only part of an edge) and every
 seam is `reversed` (all pieces face outwards). Edge names of every piece are in `pattern.meta["kimono"]["edges"]`.
@@ -47,6 +48,7 @@ from dataclasses import asdict, dataclass, fields, replace
 import numpy as np
 
 from ..errors import InputError
+from ._layers import LayerRegion
 from ._types import Curve, EdgeRef, Fold, Pattern, Piece, Placement, Seam
 
 #: Allowed ranges, cm (a child's kimono to a tall adult's; furisode sleeves reach ~115 cm).
@@ -429,5 +431,20 @@ def make_kimono(
             seam("eri", f"{side}_front_neck", f"migoro_{side}", "front_neck"),
             seam("eri", f"{side}_back_neck", f"migoro_{side}", "back_neck"),
         ]
-    meta = {"kimono": {"size": asdict(s), "label": s.label(), "edges": edges}}
+    # Left over right (SPEC §5.4): the left okumi, the left body panel's front and the collar down the left okumi
+    # lie over their right counterparts where they cross on the body.
+    front = (0.0, 0.0, K, L)
+    crossing = O + upper  # the collar along an okumi's front edge and top
+    layers = [
+        LayerRegion("okumi_left", 2),
+        LayerRegion("migoro_left", 2, front),
+        LayerRegion("eri", 2, (0.0, 0.0, e, crossing)),
+        LayerRegion("okumi_right", 1),
+        LayerRegion("migoro_right", 1, front),
+        LayerRegion("eri", 1, (0.0, Lc - crossing, e, Lc)),
+    ]
+    meta = {
+        "kimono": {"size": asdict(s), "label": s.label(), "edges": edges},
+        "layers": [r.to_dict() for r in layers],
+    }
     return Pattern("kimono", pieces, seams, meta)
