@@ -32,6 +32,10 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
 6. **Untangle** (`kitsuke.cloth.untangle`, also run at the end of step 3, before a hold band is pinned):
    triangles still folded over their neighbours are opened by relaxing only a few rings of cloth around them,
    the rest of the garment held still (`untangle_rounds`); the stroke tethers still apply.
+
+Layered cloth (a pattern's `meta["layers"]`: the kimono's left front over its right, SPEC §5.4) keeps its layer
+order in every collision update of every step (`kitsuke.cloth.keep_layers`), so the fronts never grow or settle
+through each other.
 """
 
 from __future__ import annotations

@@ -10,6 +10,7 @@ File layout::
                                "fold": {"y_cm": 158, "diameter_cm": 26}}}],              # optional
      "seams": [{"a": {"piece": "...", "edge": 0}, "b": {"piece": "...", "edge": 4}, "reversed": true}],
      "meta": {...}}                                                                    # optional, free-form
+                                          # meta "layers": which pieces lie over which when worn (see `_layers`)
 
 `units` may be "cm" (the default and what is written), "mm", "m" or "in": other units are scaled to cm on reading.
 `reversed` defaults to true. Curve types: quadratic, cubic (Bézier) and circle (an arc through the relative point
