@@ -5,10 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kitsuke.cloth import ClothModel, ClothParams, ClothState, collide, grid_sheet, keep_layers
+from kitsuke.cloth import BodyCollider, ClothModel, ClothParams, ClothState, collide, grid_sheet, keep_layers
 from kitsuke.errors import InputError
 
 from . import reference as ref
+from .conftest import icosphere
 
 
 def two_sheets(rng, *, under_z=0.0, over_z=-0.003, noise=0.001, n=9, spacing=0.015):
@@ -116,9 +117,6 @@ def test_keep_layers_holds_pins_and_inactive_faces(rng):
     state = ClothState.new(model, pos.copy(), face_active=active)
     assert keep_layers(model, state) == 0
     # collide (no body near) keeps the layers too.
-    from kitsuke.cloth import BodyCollider
-    from tests.cloth.conftest import icosphere
-
     far = BodyCollider.from_mesh(icosphere(centre=(5.0, 5.0, 5.0)))
     state = ClothState.new(model, pos.copy())
     collide(model, state, far)

@@ -191,34 +191,42 @@ def _buffers(state: ClothState) -> dict:
     return w
 
 
+def _while_active(model: ClothModel, state: ClothState, name: str, compute):
+    """`compute()`, cached on the state under `name` while face_active (and the model's size) is unchanged."""
+    w = state._work
+    key = (state.face_active.tobytes(), model.n_vertices)
+    if w.get(name + "_key") != key:
+        w[name], w[name + "_key"] = compute(), key
+    return w[name]
+
+
 def active_edge_index(model: ClothModel, state: ClothState) -> np.ndarray:
     """(E',) int64 indices into model.edges of the edges of the active triangles (cached on the state while
     face_active is unchanged)."""
-    w = state._work
-    key = state.face_active.tobytes()
-    if w.get("active_edges_key") != key:
+
+    def compute() -> np.ndarray:
         ef = model.edge_faces
-        on = state.face_active[ef[:, 0]] | ((ef[:, 1] >= 0) & state.face_active[np.maximum(ef[:, 1], 0)])
-        index = np.flatnonzero(on)
-        w["active_edge_index"], w["active_edges"], w["active_edges_key"] = index, model.edges[index], key
-    return w["active_edge_index"]
+        return np.flatnonzero(
+            state.face_active[ef[:, 0]] | ((ef[:, 1] >= 0) & state.face_active[np.maximum(ef[:, 1], 0)])
+        )
+
+    return _while_active(model, state, "active_edge_index", compute)
 
 
 def active_edges(model: ClothModel, state: ClothState) -> np.ndarray:
     """(E', 2) int64 edges of the active triangles (cached like `active_edge_index`)."""
-    active_edge_index(model, state)
-    return state._work["active_edges"]
+    return _while_active(model, state, "active_edges", lambda: model.edges[active_edge_index(model, state)])
 
 
 def vertex_active(model: ClothModel, state: ClothState) -> np.ndarray:
     """(V,) bool: vertices of at least one active triangle (cached on the state while face_active is unchanged)."""
-    key = state.face_active.tobytes()
-    w = state._work
-    if w.get("vertex_active_key") != key or len(w["vertex_active"]) != model.n_vertices:
+
+    def compute() -> np.ndarray:
         act = np.zeros(model.n_vertices, dtype=bool)
         act[model.faces[state.face_active].reshape(-1)] = True
-        w["vertex_active"], w["vertex_active_key"] = act, key
-    return w["vertex_active"]
+        return act
+
+    return _while_active(model, state, "vertex_active", compute)
 
 
 def track(model: ClothModel, state: ClothState, collider: BodyCollider, *, active: np.ndarray | None = None) -> int:
@@ -285,13 +293,12 @@ def track(model: ClothModel, state: ClothState, collider: BodyCollider, *, activ
 
 def _layer_face_vertices(model: ClothModel, state: ClothState) -> np.ndarray:
     """The vertices of the active faces that have a layer (cached on the state while face_active is unchanged)."""
-    w = state._work
-    key = state.face_active.tobytes()
-    if w.get("layer_face_vertices_key") != key:
+
+    def compute() -> np.ndarray:
         on = state.face_active[model.layer_faces]
-        lv = model.layer_face_vertices if on.all() else np.unique(model.faces[model.layer_faces[on]])
-        w["layer_face_vertices"], w["layer_face_vertices_key"] = lv, key
-    return w["layer_face_vertices"]
+        return model.layer_face_vertices if on.all() else np.unique(model.faces[model.layer_faces[on]])
+
+    return _while_active(model, state, "layer_face_vertices", compute)
 
 
 def keep_layers(model: ClothModel, state: ClothState, movable: np.ndarray | None = None) -> int:
@@ -303,9 +310,8 @@ def keep_layers(model: ClothModel, state: ClothState, movable: np.ndarray | None
     if model.face_layer is None:
         return 0
     p = model.params
-    act = vertex_active(model, state)
     if movable is None:
-        movable = act & ~state.pinned
+        movable = vertex_active(model, state) & ~state.pinned
     query = model.layer_vertices[movable[model.layer_vertices]]
     if len(query) == 0:
         return 0
