@@ -4,8 +4,15 @@ Why besides `relax` and the wrap's global relaxation: both fit each triangle's r
 per vertex (Jacobi) or in one least-squares solve, which takes out strain spread over many triangles but leaves
 what is local: a row of edges stretched along a seam, a triangle squeezed where the cloth is pressed on the body.
 Projecting edges one after another reaches those in a few hundred sweeps (measured after the wrap of
-GarmentCode's shirt on mean_all: mean edge strain 1.43 % -> 0.95 % in 300 sweeps, 0.1 s; the wrap runs 1200). It
-knows nothing of bending or folding: run `untangle` after it.
+GarmentCode's shirt on mean_all: mean edge strain 1.43 % -> 0.95 % in 300 sweeps, 0.1 s; the wrap runs 400,
+accelerated). It knows nothing of bending or folding: run `untangle` after it.
+
+Chebyshev acceleration (Wang 2015, "A Chebyshev semi-iterative approach for accelerating projective and
+position-based dynamics"): each accelerated sweep's result is extrapolated from the iterate two sweeps back,
+q <- w_k (q_sweep - q_(k-1)) + q_(k-1), with the weights w_k of the Chebyshev polynomials for a sweep whose
+error shrinks by `chebyshev_rho` per sweep. It carries a correction across the garment far faster than plain or
+over-relaxed sweeps (measured on the shipped wrap cases: 400 accelerated sweeps end at a lower mean strain than
+1200 over-relaxed ones).
 """
 
 from __future__ import annotations
@@ -20,8 +27,11 @@ from ._collide import BodyCollider, active_edge_index, collide, vertex_active
 from ._model import ClothModel, ClothState
 from ._tethers import Tethers
 
-#: Sweeps at the end of `restore_lengths` that are never over-relaxed.
+#: Sweeps at the end of `restore_lengths` that are never over-relaxed or accelerated.
 PLAIN_FINISH = 100
+#: Plain sweeps before the Chebyshev weights start (Wang 2015's delay: the first sweeps' error is not yet in the
+#: slowly shrinking modes the weights are tuned for).
+CHEBYSHEV_DELAY = 10
 
 
 @dataclass
@@ -49,6 +59,7 @@ def restore_lengths(
     tolerance_m: float = 0.0,
     tethers: Tethers | None = None,
     over_relaxation: float = 1.0,
+    chebyshev_rho: float | None = None,
 ) -> LengthStats:
     """Pull every edge of the active triangles towards its rest length (in place on `state`).
 
@@ -64,6 +75,13 @@ def restore_lengths(
         way to its rest length, which carries a correction across the garment in fewer sweeps; the last
         PLAIN_FINISH sweeps are plain (omega 1), so the edges end at rest rather than overshooting it (measured
         after the shirt's wrap at 1.5: 1.26 % mean strain without them, 0.75 % with 20-200).
+    chebyshev_rho : None (no acceleration) or the estimated spectral radius of one sweep, 0 < rho < 1: the sweeps
+        between the first CHEBYSHEV_DELAY and the last PLAIN_FINISH are Chebyshev-accelerated (module
+        docstring). Too large a rho overshoots: measured on the shipped wrap cases, 0.99 lowers the strain
+        everywhere, 0.995 raises the T-shirt's max strain 12 -> 23 %.
+    The last collision update searches every vertex's nearest body point afresh (`Contacts.forget`): the walk
+    can leave a vertex pushed into the torso at an armpit tracked to the arm, outside it (measured on the shirt's
+    wrap: 7 vertices up to 3.5 mm inside after 400 accelerated sweeps without it, none with it).
     Pinned vertices, and vertices of no active triangle, do not move.
     """
     if not isinstance(state, ClothState):
@@ -73,6 +91,8 @@ def restore_lengths(
         raise InputError(
             "restore_lengths needs sweeps >= 0, collide_every >= 1, tolerance_m >= 0 and 1 <= over_relaxation < 2"
         )
+    if chebyshev_rho is not None and not 0.0 < chebyshev_rho < 1.0:
+        raise InputError(f"restore_lengths needs 0 < chebyshev_rho < 1 (or None), got {chebyshev_rho}")
     if collider is not None and not isinstance(collider, BodyCollider):
         raise InputError("collider must be a BodyCollider or None")
     if tethers is not None and not isinstance(tethers, Tethers):
@@ -83,18 +103,40 @@ def restore_lengths(
     backward = np.ascontiguousarray(forward[::-1])
     movable = vertex_active(model, state) & ~state.pinned
     stats = LengthStats()
+    pos = state.positions
+    accelerate = chebyshev_rho is not None and sweeps > PLAIN_FINISH + CHEBYSHEV_DELAY
+    if accelerate:
+        older, start = pos.copy(), np.empty_like(pos)  # the iterates one and two sweeps back
+        weight = 1.0
     for s in range(sweeps):
-        omega = over_relaxation if s < sweeps - PLAIN_FINISH else 1.0
+        plain = s >= sweeps - PLAIN_FINISH
+        if accelerate:
+            np.copyto(start, pos)
         stats.worst_error_m = float(
             K.project_lengths(
-                state.positions, model.edges, model.rest_lengths, movable, backward if s % 2 else forward, omega
+                pos,
+                model.edges,
+                model.rest_lengths,
+                movable,
+                backward if s % 2 else forward,
+                1.0 if plain else over_relaxation,
             )
         )
         if tethers is not None and len(tethers):
-            stats.worst_tether_m = tethers.project(state.positions, movable)
+            stats.worst_tether_m = tethers.project(pos, movable)
+        if accelerate and not plain and s >= CHEBYSHEV_DELAY:
+            rho2 = chebyshev_rho * chebyshev_rho
+            weight = 2.0 / (2.0 - rho2) if s == CHEBYSHEV_DELAY else 4.0 / (4.0 - rho2 * weight)
+            pos -= older  # pinned and inactive vertices: q_sweep = q_(k-1), so they stay where they are
+            pos *= weight
+            pos += older
+        if accelerate:
+            older, start = start, older
         stats.sweeps += 1
         last = s == sweeps - 1 or max(stats.worst_error_m, stats.worst_tether_m) <= tolerance_m
         if collider is not None and ((s + 1) % collide_every == 0 or last):
+            if last:
+                state.contacts.forget()
             stats.searches += collide(model, state, collider).searches
         if last:
             break

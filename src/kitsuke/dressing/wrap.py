@@ -23,9 +23,9 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
    steps with gravity, the body contacts inside the solve and static friction: `_solve.gravity_settle`).
    Optionally a band of the garment (e.g. where a kimono's obi goes) is held: its vertices over the torso are
    pinned where they are after step 3 (`_band_held`), for the settle only (the finish has no gravity).
-5. **Finish**: Gauss-Seidel sweeps projecting each edge to its rest length, over-relaxed, take back the stretch
-   the settle's gravity left in cloth resting on the body and the local strain (`length_sweeps`,
-   `length_over_relaxation`, `kitsuke.cloth.restore_lengths`; optionally after a few global relaxation steps
+5. **Finish**: Gauss-Seidel sweeps projecting each edge to its rest length, Chebyshev-accelerated, take back the
+   stretch the settle's gravity left in cloth resting on the body and the local strain (`length_sweeps`,
+   `length_chebyshev_rho`, `kitsuke.cloth.restore_lengths`; optionally after a few global relaxation steps
    without gravity, `finish_iterations`, 0 by default). The sweeps also pull each pattern stroke back within
    `stroke_reach_m` of its body stroke where the settle let it hang farther (one-sided tethers,
    `kitsuke.cloth.Tethers`), so the strokes are met and the rest drapes freely.
@@ -115,18 +115,23 @@ class WrapParams:
         holds, the settle's pins kept) after the settle. The Jacobi settle lets gravity stretch cloth that rests
         on the body (shirt: contact edges 2.1 % -> 4.1 % stretch), far more than real fabric stretches under its
         own weight; these steps take that back and keep the drape (shirt mean strain 2.13 -> 1.43 %, hoody 2.08
-        -> 1.41 %). Off by default since the length sweeps are over-relaxed, which take it back as well: mean /
-        max strain of the whole wrap at 10 -> 0 steps: shirt 0.75 -> 0.84 % / 28 -> 30 %, hoody 0.84 -> 0.82 % /
-        29 -> 24 %, T-shirt 0.39 -> 0.41 % / 18 -> 13 %, kimono 0.64 -> 0.68 % / 63 -> 64 %; the shirt's wrap
-        ~0.25 s faster (bench_wrap median 1.81-1.86 -> 1.58-1.63 s).
+        -> 1.41 %). Off by default since the length sweeps take it back as well (measured with the sweeps
+        over-relaxed): mean / max strain of the whole wrap at 10 -> 0 steps: shirt 0.75 -> 0.84 % / 28 -> 30 %,
+        hoody 0.84 -> 0.82 % / 29 -> 24 %, T-shirt 0.39 -> 0.41 % / 18 -> 13 %, kimono 0.64 -> 0.68 % / 63 ->
+        64 %; the shirt's wrap ~0.25 s faster (bench_wrap median 1.81-1.86 -> 1.58-1.63 s).
     length_sweeps : Gauss-Seidel sweeps of `kitsuke.cloth.restore_lengths` after the settle (with collision, the
         settle's pins kept, a hold band let go): the least-squares steps take out strain spread over the garment
         but slowly; edge projection takes out the local rest. Mean strain without -> with (15 close steps, 1200
         sweeps): shirt 1.43 -> 0.81 %, hoody 1.51 -> 0.94 %, T-shirt 1.08 -> 0.46 %, kimono 1.79 -> 0.89 %.
+    length_chebyshev_rho : the length sweeps' Chebyshev acceleration (`restore_lengths`' chebyshev_rho), or
+        None. Measured 2026-11-25 on the shipped cases, mean / max strain, 1200 sweeps over-relaxed at 1.5 (the
+        default before) -> 400 sweeps accelerated at 0.99: shirt 0.89 -> 0.82 % / 31 -> 30 %, hoody 0.84 -> 0.83 %
+        / 31 -> 25 %, T-shirt 0.40 -> 0.38 % / 12 -> 12 %, kimono 0.55 -> 0.52 % / 51 -> 41 %, in 40 % of the
+        time (the shirt's finish 455 -> 192 ms). rho 0.995 overshoots (T-shirt max 23 %); 300 sweeps at 0.99
+        leave more (kimono max 63 %).
     length_over_relaxation : omega of the length sweeps (`restore_lengths`' over_relaxation; 1: plain
-        Gauss-Seidel). Mean / max strain at 1200 sweeps, 1 -> 1.5: shirt 0.87 -> 0.75 % / 30 -> 28 %, hoody 0.87
-        -> 0.84 % / 29 -> 29 %, T-shirt 0.46 -> 0.39 % / 26 -> 18 %, kimono 0.64 -> 0.64 % / 65 -> 63 %; 800
-        sweeps at 1.5 match 1200 at 1.
+        Gauss-Seidel). Before the acceleration, mean / max strain at 1200 sweeps, 1 -> 1.5: shirt 0.87 -> 0.75 %
+        / 30 -> 28 %, T-shirt 0.46 -> 0.39 % / 26 -> 18 %. With it, leave it at 1: both at once overshoot.
     length_collide_every : a collision update after this many length sweeps. 4 rather than restore_lengths' 3:
         `bench_wrap.py --repeat 7` on the shirt, alternately, 1.28 / 1.25 s median against 1.39 / 1.58 s (a noisy
         hour), the deepest vertex 0.9 mm out of the body instead of 1.5 mm; mean / max strain shirt 0.89 % / 31 %,
@@ -186,8 +191,9 @@ class WrapParams:
     settle_gravity_m: float = 0.002
     stick_weight: float = 20.0
     finish_iterations: int = 0
-    length_sweeps: int = 1200
-    length_over_relaxation: float = 1.5
+    length_sweeps: int = 400
+    length_chebyshev_rho: float | None = 0.99
+    length_over_relaxation: float = 1.0
     length_collide_every: int = 4
     stroke_reach_m: float | None = 0.008
     untangle_bend: float = 0.1
@@ -250,6 +256,8 @@ class WrapParams:
             raise InputError("wrap parameter stroke_reach_m must be > 0 (metres) or None")
         if not 1.0 <= self.length_over_relaxation < 2.0:
             raise InputError("wrap parameter length_over_relaxation must be in [1, 2)")
+        if self.length_chebyshev_rho is not None and not 0.0 < self.length_chebyshev_rho < 1.0:
+            raise InputError("wrap parameter length_chebyshev_rho must be in (0, 1) or None")
         if self.tear_strain is not None and not self.tear_strain > 0:
             raise InputError("wrap parameter tear_strain must be > 0 (a fraction: 1.0 = twice the rest length) or None")
         if not self.hold_reach_m > 0:
@@ -535,6 +543,7 @@ def wrap(
             sweeps=p.length_sweeps,
             tethers=tethers,
             over_relaxation=p.length_over_relaxation,
+            chebyshev_rho=p.length_chebyshev_rho,
             collide_every=p.length_collide_every,
         )
         state.pinned = pins
