@@ -57,7 +57,8 @@ def test_model_layers():
     off[f[layer == 0].reshape(-1)] = True
     assert (m.vertex_layer[on & ~off] == 3).all() and (m.vertex_layer[off] == 0).all()
     assert (m.layers_at[on] & (1 << 3)).all() and not m.layers_at[~on].any()
-    assert m.with_params(ClothParams(friction=0.1)).face_layer is m.face_layer
+    wider = m.with_params(ClothParams(friction=0.1, layer_reach_m=0.05))
+    assert wider.face_layer is m.face_layer and wider.layer_cell_m > m.layer_cell_m
     # All zeros: no layers.
     assert ClothModel.from_corners(f, uv[f], face_layer=np.zeros(len(f), dtype=np.int8)).face_layer is None
 

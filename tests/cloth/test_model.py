@@ -123,3 +123,13 @@ def test_locality_order_is_a_permutation_that_narrows_the_band(rng):
     a = ClothModel.from_flat(shuffled, uv[perm])
     b = ClothModel.from_corners(reordered, a.rest_corners[forder])
     np.testing.assert_allclose(np.sort(b.rest_lengths), np.sort(a.rest_lengths))
+
+
+def test_with_params_shares_the_topology_and_leaves_the_original_alone():
+    uv, f = grid_sheet(5, 4, 0.02)
+    m = ClothModel.from_flat(f, uv)
+    soft = m.with_params(ClothParams(friction=0.1, gravity_step_m=0.0))
+    assert soft.params.friction == 0.1 and m.params.friction == ClothParams().friction
+    assert soft.edges is m.edges and soft.rest_lengths is m.rest_lengths and soft.hinges is m.hinges
+    with pytest.raises(InputError, match="ClothParams"):
+        m.with_params({"friction": 0.1})
