@@ -226,9 +226,11 @@ def project_tethers(pos, tri, bary, movable, lines, line_of, reach):
     return pos, worst
 
 
-def layer_moves(pos, faces, face_layer, vertex_layer, movable, reach, gap, max_step):
+def layer_moves(pos, faces, face_layer, vertex_layer, movable, reach, gap, max_step, outward=None, near=None):
     """`keep_layers`' moves (V, 3) by brute force: every vertex with a layer against every face of another layer
-    that does not hold it (`closest_on_mesh`), then the side rules of `_collide_kernels.layer_moves`."""
+    that does not hold it (`closest_on_mesh`), then the side rules of `_collide_kernels.layer_moves`. outward
+    (V, 3), near (V,) bool: the body's outward normal at each vertex and whether it lies within reach of the
+    body; a face normal more than 120 degrees from it is turned round."""
     out = np.zeros_like(pos)
     for v in np.flatnonzero((vertex_layer > 0) & movable):
         mine = vertex_layer[v]
@@ -240,6 +242,8 @@ def layer_moves(pos, faces, face_layer, vertex_layer, movable, reach, gap, max_s
             continue
         a, b, c = pos[faces[cand[k]]]
         n = unit(np.cross(b - a, c - a))
+        if outward is not None and near[v] and n @ outward[v] < -0.5:
+            n = -n
         h = (pos[v] - q) @ n
         if d * d - h * h > (0.5 * abs(h) + 1e-3) ** 2:  # beside the other layer's border
             continue

@@ -12,14 +12,16 @@ from . import reference as ref
 from .conftest import icosphere
 
 
-def two_sheets(rng, *, under_z=0.0, over_z=-0.003, noise=0.001, n=9, spacing=0.015):
+def two_sheets(rng, *, under_z=0.0, over_z=-0.003, noise=0.001, n=9, spacing=0.015, inside_out=False):
     """Two sheets facing +z in one model: the lower layer (1) at z = under_z, the upper one (2) shifted (by 0.3 and
     0.6 cells: off the cells' diagonals, so no vertex is as near two faces) at z = over_z (below the lower one by
-    default: the wrong order), both with height noise."""
+    default: the wrong order), both with height noise. inside_out: the lower sheet faces -z (its winding
+    reversed, as where a collar lies twisted over)."""
     uv, f = grid_sheet(n, n, spacing)
     nv = len(uv)
-    faces = np.concatenate([f, f + nv])
-    rest = np.concatenate([uv[f], uv[f]])
+    lower = f[:, ::-1] if inside_out else f
+    faces = np.concatenate([lower, f + nv])
+    rest = np.concatenate([uv[lower], uv[f]])
     layer = np.r_[np.ones(len(f), dtype=np.int8), np.full(len(f), 2, dtype=np.int8)]
     model = ClothModel.from_corners(faces, rest, params=ClothParams(), face_layer=layer)
     a = np.c_[uv, np.full(nv, under_z)]
@@ -30,14 +32,15 @@ def two_sheets(rng, *, under_z=0.0, over_z=-0.003, noise=0.001, n=9, spacing=0.0
 
 
 def _over_minus_under(model, pos):
-    """Height of each upper-layer vertex over the lower sheet's surface where it lies above it (brute force)."""
+    """Height (+z) of each upper-layer vertex over the lower sheet's surface where it lies above it (brute
+    force)."""
     out = []
     under = model.faces[model.face_layer == 1]
     for v in np.flatnonzero(model.vertex_layer == 2):
         k, q, d = ref.closest_on_mesh(pos[v], pos, under)
         a, b, c = pos[under[k]]
         n = ref.unit(np.cross(b - a, c - a))
-        h = (pos[v] - q) @ n
+        h = (pos[v] - q) @ (n if n[2] > 0 else -n)
         if d * d - h * h < 1e-8:  # above the sheet, not beside it
             out.append(h)
     return np.array(out)
@@ -103,6 +106,47 @@ def test_keep_layers_puts_the_upper_layer_outside(rng):
     model, pos = two_sheets(rng, over_z=-0.05)
     state = ClothState.new(model, pos.copy())
     assert keep_layers(model, state) == 0 and (state.positions == pos).all()
+
+
+def _body_below(state, distance_m=0.01):
+    """Contacts as if a body lay under both sheets: tracked, `distance_m` away, outward +z."""
+    c = state.contacts
+    c.face[:] = 0
+    c.normal[:] = (0.0, 0.0, 1.0)
+    c.distance[:] = distance_m
+
+
+def test_keep_layers_goes_by_the_body_where_a_layer_is_inside_out(rng):
+    """The lower sheet lies inside out (its winding faces -z, the body is below): keep_layers still puts the upper
+    sheet on the side away from the body, as the brute-force reference with the same rule does. With no body
+    tracked, or the body farther than the reach (its nearest point says little), the windings alone decide, the
+    same either way, and they disagree here: the upper sheet does not get the gap over the lower one."""
+    model, pos = two_sheets(rng, over_z=-0.002, inside_out=True)
+    state = ClothState.new(model, pos.copy())
+    _body_below(state)
+    p = model.params
+    moved = keep_layers(model, state)
+    want = ref.layer_moves(
+        pos, model.faces, model.face_layer, model.vertex_layer, np.ones(len(pos), bool),
+        p.layer_reach_m, p.layer_gap_m, p.max_step_m, outward=state.contacts.normal,
+        near=np.full(len(pos), True),
+    )  # fmt: skip
+    assert moved > 20
+    np.testing.assert_allclose(state.positions - pos, want, atol=1e-12)
+    for _ in range(10):
+        keep_layers(model, state)
+    h = _over_minus_under(model, state.positions)
+    assert len(h) > 40 and h.min() >= p.layer_gap_m - 1e-4
+    by_winding = []
+    for distance in (None, 0.05):
+        state = ClothState.new(model, pos.copy())
+        if distance is not None:
+            _body_below(state, distance)
+        for _ in range(10):
+            keep_layers(model, state)
+        by_winding.append(state.positions)
+    np.testing.assert_array_equal(by_winding[0], by_winding[1])
+    assert (_over_minus_under(model, by_winding[0]) < p.layer_gap_m - 1e-4).any()
 
 
 def test_keep_layers_holds_pins_and_inactive_faces(rng):

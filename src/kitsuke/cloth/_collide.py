@@ -305,8 +305,9 @@ def keep_layers(model: ClothModel, state: ClothState, movable: np.ndarray | None
     """Restore the order of the model's cloth layers (`ClothModel.face_layer`; in place): each movable vertex of
     one layer within `params.layer_reach_m` of an active face of another moves towards its side of that face, so
     that the higher layer lies `params.layer_gap_m` outside the lower one (a Jacobi step: every vertex takes half
-    its shortfall, the other layer's vertices the other half). Returns the number of vertices moved (0 for a
-    model without layers)."""
+    its shortfall, the other layer's vertices the other half). Outside is along the face's winding, or away from
+    the body where the vertex is tracked near it and the face is turned inside out (`layer_moves`). Returns the
+    number of vertices moved (0 for a model without layers)."""
     if model.face_layer is None:
         return 0
     p = model.params
@@ -330,6 +331,9 @@ def keep_layers(model: ClothModel, state: ClothState, movable: np.ndarray | None
         model.layers_at,
         model.vertex_corners_ptr,
         model.vertex_corners,
+        state.contacts.face,
+        state.contacts.normal,
+        state.contacts.distance,
         query,
         origin,
         cell,

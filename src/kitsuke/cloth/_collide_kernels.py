@@ -486,6 +486,9 @@ def layer_moves(
     layers_at,
     corners_ptr,
     corners,
+    c_face,
+    c_normal,
+    c_dist,
     query,
     origin,
     cell,
@@ -503,7 +506,12 @@ def layer_moves(
     (along its normal, the winding's outer side) where a > b, and `gap` inside it where a < b. A vertex that
     violates this takes half the shortfall (the other layer's vertices take the other half in their own query),
     at most `max_step`. Points beside the other layer's border (nearest point on its boundary, off to the side
-    by more than half their height over it plus 1 mm) are not between the layers and are left alone.
+    by more than half their height over it plus 1 mm) are not between the layers and are left alone. "Outside"
+    is away from the body: where the vertex is tracked (c_face >= 0) the face normal is turned to agree with the
+    body's outward normal there (c_normal), so cloth lying inside out (a collar twisted over) still keeps the
+    order. Only where the vertex lies within `reach` of the body (c_dist) and the face clearly faces it (normals
+    more than 120 degrees apart): farther out, the nearest body point (a thigh beside a hanging hem) says little
+    about which way is out. Elsewhere the winding alone decides.
 
     The nearest face is searched among the faces around the nearest vertex that lies on a face of another layer
     (and the next two nearest where the nearest point found lies on the rim of that fan). Grid (`items`, cells of
@@ -574,6 +582,12 @@ def layer_moves(
         if nn <= 1e-20:
             continue
         nx, ny, nz = nx / nn, ny / nn, nz / nn
+        if (
+            c_face[v] >= 0
+            and c_dist[v] < reach
+            and nx * c_normal[v, 0] + ny * c_normal[v, 1] + nz * c_normal[v, 2] < -0.5
+        ):
+            nx, ny, nz = -nx, -ny, -nz
         h = (px - bqx) * nx + (py - bqy) * ny + (pz - bqz) * nz
         side = max(best - h * h, 0.0)
         if side > (0.5 * abs(h) + 1e-3) ** 2:
