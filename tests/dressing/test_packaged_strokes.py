@@ -38,6 +38,7 @@ class Case:
 
 
 CASES = {
+    # measured 2026-11-25 (Chebyshev finish): 0.82 % / 30 %.
     # measured 2026-11-24: strain 0.87 % / 30 %, 0 inverted, residual 8.6 mm (21 mm without the stroke tethers),
     # deepest 1.0 mm (before the length restoration: 1.43 % / 33 %, 18 mm; before the finish step: 2.13 % / 44 %)
     "shirt": Case(
@@ -47,6 +48,7 @@ CASES = {
         0.45,
         (0.95, 1.10, 1.38, 1.50),
     ),
+    # measured 2026-11-25 (Chebyshev finish): 0.83 % / 25 %.
     # measured 2026-11-24: strain 0.87 % / 29 % (before the length restoration 1.41-1.56 % / 30-59 %, moving
     # with the installed libraries' versions), 0 inverted, residual 8.4 mm (22 mm without the stroke tethers: the
     # hood hangs behind the head), the hood reaching over the top of the head
@@ -57,6 +59,7 @@ CASES = {
         0.5,
         (0.92, 1.10, 1.66, 1.78),
     ),
+    # measured 2026-11-25 (Chebyshev finish): 0.38 % / 12 %.
     # measured 2026-11-24: strain 0.46 % / 26 %, 0 inverted, residual 8.2 mm (15 mm without the stroke tethers),
     # no vertex inside (cut for a 110 cm chest on an 84 cm one: it hangs loose to the thighs)
     "tshirt": Case(
