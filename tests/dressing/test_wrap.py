@@ -448,6 +448,9 @@ def test_wrap_rejects_a_missing_piece_and_bad_params():
     for omega in (0.5, 2.0, float("nan")):
         with pytest.raises(InputError, match="length_over_relaxation"):
             WrapParams(length_over_relaxation=omega)
+    for rho in (0.0, 1.0, float("nan")):
+        with pytest.raises(InputError, match="length_chebyshev_rho"):
+            WrapParams(length_chebyshev_rho=rho)
     with pytest.raises(InputError, match="hold_reach_m"):
         WrapParams(hold_reach_m=0.0)
     with pytest.raises(InputError, match="hold_reach_m"):

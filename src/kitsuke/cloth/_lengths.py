@@ -107,7 +107,7 @@ def restore_lengths(
     accelerate = chebyshev_rho is not None and sweeps > PLAIN_FINISH + CHEBYSHEV_DELAY
     if accelerate:
         older, start = pos.copy(), np.empty_like(pos)  # the iterates one and two sweeps back
-        weight = 1.0
+        rho2, weight = chebyshev_rho * chebyshev_rho, 1.0
     for s in range(sweeps):
         plain = s >= sweeps - PLAIN_FINISH
         if accelerate:
@@ -125,7 +125,6 @@ def restore_lengths(
         if tethers is not None and len(tethers):
             stats.worst_tether_m = tethers.project(pos, movable)
         if accelerate and not plain and s >= CHEBYSHEV_DELAY:
-            rho2 = chebyshev_rho * chebyshev_rho
             weight = 2.0 / (2.0 - rho2) if s == CHEBYSHEV_DELAY else 4.0 / (4.0 - rho2 * weight)
             pos -= older  # pinned and inactive vertices: q_sweep = q_(k-1), so they stay where they are
             pos *= weight
