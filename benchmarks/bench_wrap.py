@@ -25,15 +25,14 @@ def main() -> None:
     from kitsuke.cloth import BodyCollider
     from kitsuke.dressing import read_strokes, resolve_strokes
     from kitsuke.dressing.wrap import WrapParams, wrap
-    from kitsuke.geometry.surface import Surface
     from kitsuke.pattern import load_pattern, mesh_pattern
 
     body = load_body(ROOT / "tests/data/bodies/mean_all.obj")
     pattern = load_pattern(ROOT / "tests/data/pattern/shirt_mean_specification.json")
     strokes = read_strokes(ROOT / "src/kitsuke/assets/strokes/shirt_mean_all.json")
     pm = mesh_pattern(pattern, edge_length=1.5)
-    resolved = resolve_strokes(strokes, pattern, Surface(body.mesh), pattern_mesh=pm)
     collider = BodyCollider.from_body(body)
+    resolved = resolve_strokes(strokes, pattern, collider.surface, pattern_mesh=pm)
     params = WrapParams() if args.settle == "jacobi" else WrapParams(settle="global", settle_iterations=30)
     wrap(body, pm, resolved, collider=collider, params=params, report=False)  # warm-up
     walls = []

@@ -116,6 +116,24 @@ def test_moved_body_keeps_tracking(sphere):
     assert state.contacts.distance[0] == pytest.approx(model.params.contact_offset_m, abs=2e-4)
 
 
+def test_collider_surface_is_built_once_and_shared(sphere, rng):
+    """The wrap places its strokes with the collider's own Surface (one AABB tree per body, not one per wrap);
+    a mesh in another pose gets a Surface of its own. `nearest` answers from the same tree."""
+    col = BodyCollider.from_mesh(sphere)
+    assert col.surface is col.surface
+    assert col.surface_for(TriMesh(sphere.vertices.copy(), sphere.faces.copy())) is col.surface
+    other = col.surface_for(TriMesh(sphere.vertices * 1.1, sphere.faces))
+    assert other is not col.surface
+    pts = rng.normal(size=(20, 3)) * 0.2
+    face, point, dist = col.nearest(pts)
+    brute = np.array(
+        [min(np.linalg.norm(p - ref.closest_on_triangle(p, *sphere.vertices[f])) for f in sphere.faces) for p in pts]
+    )
+    np.testing.assert_allclose(dist, brute, atol=1e-9)
+    np.testing.assert_allclose(np.linalg.norm(point - pts, axis=1), dist, atol=1e-9)
+    assert np.all(other.closest(pts).distance > 0) and not np.allclose(other.closest(pts).distance, dist)
+
+
 def test_collider_rejects_open_mesh(sphere):
     with pytest.raises(InputError, match="not closed"):
         BodyCollider.from_mesh(TriMesh(sphere.vertices, sphere.faces[1:]), source="holey.obj")

@@ -64,7 +64,6 @@ import numpy as np
 from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, collide, relax, track, untangle
 from ..errors import InputError
 from ..geometry import TriMesh
-from ..geometry.surface import Surface
 from ..metrics import QualityReport, quality_report
 from . import _drag_kernels as K
 from ._drag_field import body_axis, drag_weights, smooth_falloff
@@ -258,7 +257,7 @@ class DragSession:
         self.grabbed: Grab | None = None
         self._solver: GlobalRelax | None = None
         self._moved = False
-        self._surface = Surface(mesh)
+        self._surface = collider.surface_for(mesh)
         # Each vertex's foot on the body, tracked by walking from where it was (never a global jump to another
         # body part while the walk succeeds): the state's own contacts stop tracking cloth far from the body.
         self._foot_model = self.model.with_params(dataclasses.replace(self.params.cloth, track_distance_m=1e3))

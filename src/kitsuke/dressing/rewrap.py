@@ -194,7 +194,7 @@ def rewrap(
     pinned = snap_pins(g, pins, source=src)
     if pinned.all():
         raise InputError("every garment vertex is pinned: nothing can move", src)
-    body_surface = Surface(mesh)
+    body_surface = collider.surface_for(mesh)
     strokes = strokes_on_surface(strokes, Surface(TriMesh(g.positions, g.faces, name=g.name)))
     timings = {"prepare": time.perf_counter() - t0}
 
