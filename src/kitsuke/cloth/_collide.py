@@ -174,8 +174,7 @@ class BodyCollider:
 
     def nearest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Global nearest-surface query (`surface`): face (n,) int64, point (n, 3), distance (n,)."""
-        hit = self.surface.closest(points)
-        return hit.faces, hit.points, hit.distance
+        return self.surface.nearest(points)
 
 
 @dataclass
@@ -308,7 +307,11 @@ def _layer_face_vertices(model: ClothModel, state: ClothState) -> np.ndarray:
 
     def compute() -> np.ndarray:
         on = state.face_active[model.layer_faces]
-        return model.layer_face_vertices if on.all() else np.unique(model.faces[model.layer_faces[on]])
+        if on.all():
+            return model.layer_face_vertices
+        mark = np.zeros(model.n_vertices, dtype=bool)  # recomputed at every growth ring: faster than np.unique
+        mark[model.faces[model.layer_faces[on]].reshape(-1)] = True
+        return np.flatnonzero(mark)
 
     return _while_active(model, state, "layer_face_vertices", compute)
 

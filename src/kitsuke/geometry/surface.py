@@ -125,9 +125,18 @@ class Surface:
     # -- closest points --------------------------------------------------------------------------------------
     def closest(self, points: np.ndarray) -> SurfacePoints:
         """The closest surface point to each of `points` (n, 3) metres, any distance away (libigl AABB)."""
+        face, point, distance = self.nearest(points)
+        if len(face) == 0:
+            return SurfacePoints.empty()
+        bary = barycentric_coordinates(self.vertices[self.faces[face]], point)
+        return SurfacePoints(point, face, bary, distance)
+
+    def nearest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """`closest` without the barycentric coordinates (what collision needs, many times per wrap): face (n,)
+        int64, point (n, 3) metres, distance (n,) metres."""
         pts = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 3)
         if len(pts) == 0:
-            return SurfacePoints.empty()
+            return np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0)
         if not np.isfinite(pts).all():
             raise ValueError("closest: points hold NaN or infinity")
         if self._aabb is None:
@@ -136,9 +145,7 @@ class Surface:
             self._aabb = igl.AABB()
             self._aabb.init(self.vertices, self.faces)
         d2, face, point = self._aabb.squared_distance(self.vertices, self.faces, pts)
-        face = face.astype(np.int64)
-        bary = barycentric_coordinates(self.vertices[self.faces[face]], point)
-        return SurfacePoints(point, face, bary, np.sqrt(np.maximum(d2, 0.0)))
+        return face.astype(np.int64), point, np.sqrt(np.maximum(d2, 0.0))
 
     # -- rays ------------------------------------------------------------------------------------------------
     def _intersector(self):
