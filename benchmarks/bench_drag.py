@@ -1,6 +1,6 @@
 """Benchmark: dragging a ~5k-vertex garment along the default body (issue 4: one update <= 33 ms).
 
-    /work/venv/bin/python benchmarks/bench_drag.py [--garment kimono|tshirt] [--edge-length CM] [--updates 60]
+    python benchmarks/bench_drag.py [--garment kimono|tshirt] [--edge-length CM] [--updates 60]
 
 The garment: the default kimono at 2.5 cm (5.3k vertices, sleeves hanging; its coarse hem can tear round the
 shins under these rough drags, which the quality line after the drag shows) or the FreeSewing T-shirt with its

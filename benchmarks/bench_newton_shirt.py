@@ -1,10 +1,11 @@
 """Benchmark: kitsuke's wrap vs NVIDIA newton (VBD cloth, CPU) on GarmentCode's shirt and mean_all, same run.
 
-    /work/venv/bin/python benchmarks/bench_newton_shirt.py [--sew-frames 40] [--frames 60] [--substeps 5]
+    python benchmarks/bench_newton_shirt.py [--sew-frames 40] [--frames 60] [--substeps 5]
 
 Takes about 4 minutes on 2 CPU cores (newton: ~50 s of kernel compilation, then ~70 s per drape).
 
-newton is not a kitsuke dependency (`/work/venv/bin/pip install newton`); without it this script says so and exits 0.
+newton is not a kitsuke dependency (`pip install newton==1.8.0 warp-lang==1.19.0` into the same environment);
+without it this script says so and exits 0.
 
 newton's side: the shirt's pattern mesh (1.5 cm edges) starts at GarmentCode's own panel placement
 (`PatternMesh.positions_m`); every piece is a flat panel moved rigidly, so its placed triangles are its rest shape.
