@@ -137,7 +137,7 @@ def test_without_tethers_the_garment_settles_away_from_its_strokes():
     assert g.report.penetration_count == 0 and g.report.inverted_count == 0
 
 
-@pytest.mark.xfail(strict=True, reason="issue 3 target not met: max strain 12-31 % (vertices with > 360° of pattern)")
+@pytest.mark.xfail(strict=True, reason="issue 3 target not met: max strain 12-30 % (cones > 360°, compressed ease)")
 def test_issue_targets(dressed):
     _, g = dressed
     assert g.report.strain_max <= 0.05
