@@ -138,7 +138,7 @@ class Surface:
         if len(pts) == 0:
             return np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0)
         if not np.isfinite(pts).all():
-            raise ValueError("closest: points hold NaN or infinity")
+            raise ValueError("surface query: points hold NaN or infinity")
         if self._aabb is None:
             import igl
 
