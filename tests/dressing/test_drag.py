@@ -233,6 +233,27 @@ def test_roll_up_a_kimono_sleeve(body, kimono, collider):
     assert_kimono_targets_kept(before, s.report())
 
 
+# -- rough drags ---------------------------------------------------------------------------------------------------
+def test_rough_drags_up_and_down_do_not_tear_the_coarse_kimono(body, collider):
+    """The kimono at 2.5 cm (as benchmarks/bench_drag.py drags it) lifted 10 cm by its front and put back, three
+    times, in 1 cm updates: its hem round the shins does not tear (206 % max strain, 2.8 % mean, when collision
+    only followed the global relaxation and fought it), and the wrap's targets it met still hold."""
+    from kitsuke.dressing import WrapParams
+    from kitsuke.dressing.kimono import dress_default_kimono
+
+    coarse = dress_default_kimono(body, params=WrapParams(edge_length_cm=2.5))
+    s = DragSession(body, coarse, collider=collider)
+    before = s.report()
+    s.grab(vertex=front_of(s.positions, 1.1))
+    for _ in range(3):
+        s.move_by([0.0, 0.1, 0.0])
+        s.move_by([0.0, -0.1, 0.0])
+    s.release()
+    after = s.report()
+    assert_kimono_targets_kept(before, after)
+    assert after.strain_max < before.strain_max + 0.1
+
+
 # -- API behaviour and bad input ----------------------------------------------------------------------------------
 def test_session_takes_the_garment_file_and_reports_timings(body, skirt, collider):
     garment, _ = skirt
@@ -280,5 +301,9 @@ def test_bad_input_raises_and_leaves_the_garment_unchanged(body, skirt, collider
         DragParams(release_untangle_rounds=-1)
     with pytest.raises(InputError, match="release_untangle_iterations"):
         DragParams(release_untangle_iterations=0)
+    with pytest.raises(InputError, match="contact_iterations"):
+        DragParams(contact_iterations=0)
+    with pytest.raises(InputError, match="contact_weight"):
+        DragParams(contact_weight=float("nan"))
     with pytest.raises(InputError):
         DragSession(body, "not a garment")
