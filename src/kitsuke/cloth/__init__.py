@@ -1,5 +1,6 @@
-"""Cloth core: the static model, the relaxation of the paper, edge-length restoration, Skin-style body collision
-with capsule bones, adaptive sqrt(3) subdivision, and untangling of folded triangles.
+"""Cloth core: the static model, the relaxation of the paper, edge-length restoration, an energy polish that caps
+strain, Skin-style body collision with capsule bones, adaptive sqrt(3) subdivision, and untangling of folded
+triangles.
 
 Typical use::
 
@@ -15,6 +16,7 @@ small move down, and collision pushes the cloth out of the body. Constants live 
 from ._collide import BodyCollider, CollisionStats, collide, keep_layers, track, vertex_active
 from ._lengths import LengthStats, restore_lengths
 from ._model import ClothModel, ClothParams, ClothState, Contacts, locality_order
+from ._polish import PolishStats, bending_matrix, polish
 from ._relax import RelaxStats, relax
 from ._shapes import grid_sheet, grid_tube, hugging_tube, triangle_frames
 from ._subdivide import Refinement, colliding_edges, refine, sqrt3_split
@@ -29,6 +31,7 @@ __all__ = [
     "CollisionStats",
     "Contacts",
     "LengthStats",
+    "PolishStats",
     "Refinement",
     "RelaxStats",
     "Tethers",
@@ -38,10 +41,12 @@ __all__ = [
     "grow_region",
     "keep_layers",
     "colliding_edges",
+    "bending_matrix",
     "grid_sheet",
     "grid_tube",
     "hugging_tube",
     "locality_order",
+    "polish",
     "refine",
     "relax",
     "restore_lengths",

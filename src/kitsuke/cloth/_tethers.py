@@ -81,6 +81,23 @@ class Tethers:
     def __len__(self) -> int:
         return len(self.tri)
 
+    def nearest(self, positions: np.ndarray) -> np.ndarray:
+        """(n, 3) metres: the nearest point of each cloth point's polyline to it (positions (V, 3) metres)."""
+        p = np.einsum("nk,nkc->nc", self.bary, positions[self.tri])
+        out = np.empty_like(p)
+        for line in range(len(self.line_start) - 1):
+            sel = np.flatnonzero(self.line_of == line)
+            pts = self.line_points[self.line_start[line] : self.line_start[line + 1]]
+            if len(pts) == 1 or not len(sel):
+                out[sel] = pts[0]
+                continue
+            a, ab = pts[:-1], pts[1:] - pts[:-1]
+            t = np.einsum("nsc,sc->ns", p[sel, None] - a[None], ab) / np.maximum(np.einsum("sc,sc->s", ab, ab), 1e-300)
+            q = a[None] + np.clip(t, 0.0, 1.0)[..., None] * ab[None]
+            best = np.argmin(np.einsum("nsc,nsc->ns", q - p[sel, None], q - p[sel, None]), axis=1)
+            out[sel] = q[np.arange(len(sel)), best]
+        return out
+
     def project(self, positions: np.ndarray, movable: np.ndarray) -> float:
         """One sweep (in place on positions (V, 3)): every point beyond its reach pulled back to it, its vertices
         moving only where `movable` (V,) bool is set on all three. Returns the farthest beyond reach met, metres."""
