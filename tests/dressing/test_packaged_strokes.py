@@ -59,7 +59,7 @@ CASES = {
         0.5,
         (0.92, 1.10, 1.66, 1.78),
     ),
-    # measured 2026-11-25 (Chebyshev finish): 0.38 % / 12 %.
+    # measured 2026-11-25 (polish): 0.45 % / 3.1 %, residual 8.0 mm; (Chebyshev finish, no polish): 0.38 % / 12 %.
     # measured 2026-11-24: strain 0.46 % / 26 %, 0 inverted, residual 8.2 mm (15 mm without the stroke tethers),
     # no vertex inside (cut for a 110 cm chest on an 84 cm one: it hangs loose to the thighs)
     "tshirt": Case(
@@ -137,8 +137,18 @@ def test_without_tethers_the_garment_settles_away_from_its_strokes():
     assert g.report.penetration_count == 0 and g.report.inverted_count == 0
 
 
-@pytest.mark.xfail(strict=True, reason="issue 3 target not met: max strain 12-30 % (cones > 360°, compressed ease)")
-def test_issue_targets(dressed):
+#: Cases whose max strain is still over issue 3's 5 % (measured 2026-11-25: shirt 30 %, hoody 25 %; the polish
+#: lowers both but folds triangles, and opening them costs more than it gained, so the wrap keeps its result).
+MAX_STRAIN_MISSED = {"shirt", "hoody"}
+
+
+def test_max_strain_target(dressed, request):
+    """Issue 3's max edge strain target (5 %): met by the T-shirt since the wrap's polish (measured 2026-11-25:
+    3.1 %; 11.6 % without it)."""
+    if request.node.callspec.params["dressed"] in MAX_STRAIN_MISSED:
+        request.applymarker(
+            pytest.mark.xfail(strict=True, reason="issue 3 target not met: cones > 360°, compressed ease")
+        )
     _, g = dressed
     assert g.report.strain_max <= 0.05
 
