@@ -1,6 +1,6 @@
 """Benchmark: wrap + settle of GarmentCode's shirt (1.5 cm edges) on mean_all with the packaged strokes.
 
-    python benchmarks/bench_wrap.py [--repeat 5] [--settle global]
+    python benchmarks/bench_wrap.py [--repeat 5] [--settle global] [--polish-rounds 0]
 
 Prints the per-step timings of each run after a warm-up run (numba compilation, AABB trees) and the quality.
 """
@@ -8,6 +8,7 @@ Prints the per-step timings of each run after a warm-up run (numba compilation, 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import time
 from pathlib import Path
 
@@ -20,6 +21,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--settle", choices=["jacobi", "global"], default="jacobi", help="WrapParams.settle")
+    ap.add_argument(
+        "--polish-rounds", type=int, default=None, help="WrapParams.polish_rounds (default: the wrap's; 0: no polish)"
+    )
     args = ap.parse_args()
     from kitsuke.body import load_body
     from kitsuke.cloth import BodyCollider
@@ -34,6 +38,8 @@ def main() -> None:
     collider = BodyCollider.from_body(body)
     resolved = resolve_strokes(strokes, pattern, collider.surface, pattern_mesh=pm)
     params = WrapParams() if args.settle == "jacobi" else WrapParams(settle="global", settle_iterations=30)
+    if args.polish_rounds is not None:
+        params = dataclasses.replace(params, polish_rounds=args.polish_rounds)
     wrap(body, pm, resolved, collider=collider, params=params, report=False)  # warm-up
     walls = []
     for _ in range(args.repeat):
