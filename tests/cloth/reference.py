@@ -179,9 +179,10 @@ def segment_segment_distance(p1, q1, p2, q2, samples: int = 20001):
     return np.linalg.norm(x - (p2 + t * u), axis=1).min()
 
 
-def project_lengths(pos, edges, rest, movable, order, omega=1.0):
+def project_lengths(pos, edges, rest, movable, order, omega=1.0, band=0.0):
     """One Gauss-Seidel sweep in `order`: each edge's movable ends moved along it, equally, to its rest length
-    (omega times the way there)."""
+    (omega times the way there); with band > 0, only an edge longer than (1 + band) rest or shorter than
+    (1 - band) rest, and only to that length."""
     pos = pos.copy()
     worst = 0.0
     for e in order:
@@ -191,8 +192,11 @@ def project_lengths(pos, edges, rest, movable, order, omega=1.0):
             continue
         d = pos[b] - pos[a]
         length = np.linalg.norm(d)
-        worst = max(worst, abs(length - rest[e]))
-        corr = omega * (length - rest[e]) / w.sum() * d / length
+        target = np.clip(length, (1 - band) * rest[e], (1 + band) * rest[e])
+        if target == length:
+            continue
+        worst = max(worst, abs(length - target))
+        corr = omega * (length - target) / w.sum() * d / length
         pos[a] += w[0] * corr
         pos[b] -= w[1] * corr
     return pos, worst

@@ -168,7 +168,7 @@ def test_project_lengths_matches_reference_and_keeps_fixed_vertices(crumpled, rn
     order = rng.permutation(model.n_edges).astype(np.int64)
     for omega in (1.0, 1.5):
         got = pos.copy()
-        worst = K.project_lengths(got, model.edges, model.rest_lengths, movable, order, omega)
+        worst = K.project_lengths(got, model.edges, model.rest_lengths, movable, order, omega, 0.0)
         expect, expect_worst = ref.project_lengths(pos, model.edges, model.rest_lengths, movable, order, omega)
         np.testing.assert_allclose(got, expect, atol=ATOL)
         assert worst == pytest.approx(expect_worst)
@@ -179,10 +179,40 @@ def test_project_lengths_matches_reference_and_keeps_fixed_vertices(crumpled, rn
         if movable[model.edges[last]].any():
             a, b = model.edges[last]
             before = pos.copy()
-            K.project_lengths(before, model.edges, model.rest_lengths, movable, order[:-1], omega)
+            K.project_lengths(before, model.edges, model.rest_lengths, movable, order[:-1], omega, 0.0)
             err = np.linalg.norm(before[b] - before[a]) - model.rest_lengths[last]
             expect_len = model.rest_lengths[last] + (1.0 - omega) * err
             assert np.linalg.norm(got[b] - got[a]) == pytest.approx(expect_len)
+
+
+def test_project_lengths_with_a_band_limits_strain_only(crumpled, rng):
+    """band > 0 (a strain limit): the kernel matches the reference; cloth whose every edge is within the band is
+    left exactly as it is; the edge corrected last ends on the band's edge, not at its rest length."""
+    model, pos = crumpled
+    movable = rng.random(model.n_vertices) > 0.2
+    order = rng.permutation(model.n_edges).astype(np.int64)
+    band = 0.05
+    got = pos.copy()
+    worst = K.project_lengths(got, model.edges, model.rest_lengths, movable, order, 1.0, band)
+    expect, expect_worst = ref.project_lengths(pos, model.edges, model.rest_lengths, movable, order, 1.0, band)
+    np.testing.assert_allclose(got, expect, atol=ATOL)
+    assert worst == pytest.approx(expect_worst) and worst > 0
+    a, b = model.edges[order[-1]]
+    if movable[[a, b]].any():
+        before = pos.copy()
+        K.project_lengths(before, model.edges, model.rest_lengths, movable, order[:-1], 1.0, band)
+        s_before = np.linalg.norm(before[b] - before[a]) / model.rest_lengths[order[-1]] - 1
+        s_after = np.linalg.norm(got[b] - got[a]) / model.rest_lengths[order[-1]] - 1
+        assert abs(s_before) > band and s_after == pytest.approx(np.sign(s_before) * band)
+    # The flat rest shape grown by 3 % everywhere: every edge within 5 %, nothing moves.
+    flat = model.rest_corners.reshape(-1, 2)
+    rest_pos = np.zeros((model.n_vertices, 3))
+    rest_pos[model.faces.reshape(-1), :2] = flat * 1.03
+    uniform = np.abs(np.linalg.norm(np.diff(rest_pos[model.edges], axis=1)[:, 0], axis=1) / model.rest_lengths - 1.03)
+    assert uniform.max() < 1e-9  # one flat piece: its corners agree on each vertex
+    kept = rest_pos.copy()
+    assert K.project_lengths(kept, model.edges, model.rest_lengths, movable, order, 1.0, band) == 0.0
+    np.testing.assert_array_equal(kept, rest_pos)
 
 
 def test_project_tethers_matches_reference_and_moves_only_what_is_out_of_reach(crumpled, rng):

@@ -129,7 +129,7 @@ def test_compressed_cloth_on_a_floor_buckles_up_instead_of_staying_compressed():
     assert before.max > 0.07
     assert after.max < 0.05 and after.mean < 0.02
     assert stats.rounds == 6 and stats.iterations > 0
-    assert state.positions[~corners, 2].min() > 0.003 - 1e-4  # kept the contact offset above the floor
+    assert state.positions[~corners, 2].min() > model.params.contact_offset_m - 1e-4  # kept the offset above the floor
     assert state.positions[:, 2].max() > 0.01  # it buckled up
     np.testing.assert_array_equal(state.positions[corners], squeezed[corners])
     assert stats.folded == folded_faces(model, state).sum()

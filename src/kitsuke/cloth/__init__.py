@@ -13,10 +13,19 @@ Typical use::
 small move down, and collision pushes the cloth out of the body. Constants live in `ClothParams`.
 """
 
-from ._collide import BodyCollider, CollisionStats, collide, keep_layers, track, vertex_active
+from ._collide import (
+    BodyCollider,
+    CollisionStats,
+    LayerPlanes,
+    collide,
+    keep_layers,
+    layer_planes,
+    track,
+    vertex_active,
+)
 from ._lengths import LengthStats, restore_lengths
 from ._model import ClothModel, ClothParams, ClothState, Contacts, locality_order
-from ._polish import PolishStats, bending_matrix, polish
+from ._polish import PolishStats, RefinedPolish, bending_matrix, polish, polish_refined
 from ._relax import RelaxStats, relax
 from ._shapes import grid_sheet, grid_tube, hugging_tube, triangle_frames
 from ._subdivide import Refinement, colliding_edges, refine, sqrt3_split
@@ -30,8 +39,10 @@ __all__ = [
     "ClothState",
     "CollisionStats",
     "Contacts",
+    "LayerPlanes",
     "LengthStats",
     "PolishStats",
+    "RefinedPolish",
     "Refinement",
     "RelaxStats",
     "Tethers",
@@ -40,6 +51,7 @@ __all__ = [
     "folded_faces",
     "grow_region",
     "keep_layers",
+    "layer_planes",
     "colliding_edges",
     "bending_matrix",
     "grid_sheet",
@@ -47,6 +59,7 @@ __all__ = [
     "hugging_tube",
     "locality_order",
     "polish",
+    "polish_refined",
     "refine",
     "relax",
     "restore_lengths",

@@ -316,28 +316,40 @@ def _layer_face_vertices(model: ClothModel, state: ClothState) -> np.ndarray:
     return _while_active(model, state, "layer_face_vertices", compute)
 
 
-def keep_layers(model: ClothModel, state: ClothState, movable: np.ndarray | None = None) -> int:
-    """Restore the order of the model's cloth layers (`ClothModel.face_layer`; in place): each movable vertex of
-    one layer within `params.layer_reach_m` of an active face of another moves towards its side of that face, so
-    that the higher layer lies `params.layer_gap_m` outside the lower one (a Jacobi step: every vertex takes half
-    its shortfall, the other layer's vertices the other half). Outside is along the face's winding, or away from
-    the body where the vertex is tracked near it and the face is turned inside out (`layer_moves`). Returns the
-    number of vertices moved (0 for a model without layers)."""
+@dataclass
+class LayerPlanes:
+    """Where layered cloth lies against another layer (`layer_planes`): per vertex j, vertex[j] must lie at least
+    the layer gap along normal[j] (unit) from the point with barycentric coordinates bary[j] (3,) in face[j] of
+    the other layer. vertex, face : (n,) int64; bary, normal : (n, 3) float64."""
+
+    vertex: np.ndarray
+    face: np.ndarray
+    bary: np.ndarray
+    normal: np.ndarray
+
+    @classmethod
+    def empty(cls) -> LayerPlanes:
+        return cls(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros((0, 3)))
+
+
+def _layer_search(model: ClothModel, state: ClothState, movable: np.ndarray | None):
+    """keep_layers' search: (query vertices, moves, faces, barycentrics, normals), or None with nothing to do."""
     if model.face_layer is None:
-        return 0
+        return None
     p = model.params
     if movable is None:
         movable = vertex_active(model, state) & ~state.pinned
     query = model.layer_vertices[movable[model.layer_vertices]]
     if len(query) == 0:
-        return 0
+        return None
     others = _layer_face_vertices(model, state)
     pos = state.positions
     if len(others) == 0:
-        return 0
+        return None
     origin, cell, dims, ptr, items = K.point_grid(pos, others, model.layer_cell_m, 8 * len(others))
-    move = np.empty((len(query), 3))
-    moved = K.layer_moves(
+    move, face = np.empty((len(query), 3)), np.empty(len(query), dtype=np.int64)
+    bary, normal = np.empty((len(query), 3)), np.empty((len(query), 3))
+    K.layer_moves(
         pos,
         model.faces,
         model.face_layer,
@@ -360,9 +372,39 @@ def keep_layers(model: ClothModel, state: ClothState, movable: np.ndarray | None
         p.layer_gap_m,
         p.max_step_m,
         move,
+        face,
+        bary,
+        normal,
     )
-    pos[query] += move
-    return int(moved)
+    return query, move, face, bary, normal
+
+
+def layer_planes(model: ClothModel, state: ClothState, movable: np.ndarray | None = None) -> LayerPlanes:
+    """The layer order as constraints: every movable layered vertex that lies over or under a face of another
+    layer within `params.layer_reach_m` (keep_layers' search and its rule for which side is out), with the plane
+    it must stay outside (a higher layer) or inside (a lower one) of, whether it does already or not. The polish
+    keeps them as penalties so that its large moves cannot pass one layer through another."""
+    found = _layer_search(model, state, movable)
+    if found is None:
+        return LayerPlanes.empty()
+    query, _, face, bary, normal = found
+    k = face >= 0
+    return LayerPlanes(query[k], face[k], bary[k], normal[k])
+
+
+def keep_layers(model: ClothModel, state: ClothState, movable: np.ndarray | None = None) -> int:
+    """Restore the order of the model's cloth layers (`ClothModel.face_layer`; in place): each movable vertex of
+    one layer within `params.layer_reach_m` of an active face of another moves towards its side of that face, so
+    that the higher layer lies `params.layer_gap_m` outside the lower one (a Jacobi step: every vertex takes half
+    its shortfall, the other layer's vertices the other half). Outside is along the face's winding, or away from
+    the body where the vertex is tracked near it and the face is turned inside out (`layer_moves`). Returns the
+    number of vertices moved (0 for a model without layers)."""
+    found = _layer_search(model, state, movable)
+    if found is None:
+        return 0
+    query, move = found[:2]
+    state.positions[query] += move
+    return int((move != 0.0).any(axis=1).sum())
 
 
 def collide(model: ClothModel, state: ClothState, collider: BodyCollider) -> CollisionStats:

@@ -500,6 +500,9 @@ def layer_moves(
     gap,
     max_step,
     out,
+    out_face,
+    out_bary,
+    out_normal,
 ):
     """Moves (Q, 3) into `out` that restore the order of cloth layers at the vertices `query` (Q,): a vertex of
     layer a nearest (within `reach`) to a face of another layer b must lie at least `gap` outside that face
@@ -518,10 +521,15 @@ def layer_moves(
     at least `reach` plus most of an edge; grid_pos: their positions in grid order); `layers_at`: bit l set where
     a vertex has a face of layer l; inactive faces are skipped; corners_ptr, corners: CSR of the corners
     (face * 3 + k) at each vertex.
+    Each vertex's constraint goes to out_face (Q,) (the other layer's face, -1 where none applies), out_bary
+    (Q, 3) (the nearest point's barycentric coordinates in it) and out_normal (Q, 3) (the unit direction the
+    vertex must lie along from that point: (x_v - point) . out_normal >= gap), violated or not: the polish keeps
+    them as planes (`layer_planes`).
     Returns the number of vertices moved."""
     moved = 0
     for qi in prange(query.shape[0]):
         out[qi, 0] = out[qi, 1] = out[qi, 2] = 0.0
+        out_face[qi] = -1
         v = query[qi]
         lv = vertex_layer[v]
         px, py, pz = pos[v, 0], pos[v, 1], pos[v, 2]
@@ -552,6 +560,7 @@ def layer_moves(
         best = reach * reach
         bf = -1
         bqx = bqy = bqz = 0.0
+        bb0 = bb1 = bb2 = 0.0
         for k in range(3):
             u = c0 if k == 0 else (c1 if k == 1 else c2)
             if u < 0:
@@ -562,10 +571,11 @@ def layer_moves(
                 i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
                 if face_layer[f] == 0 or face_layer[f] == lv or not face_active[f] or i0 == v or i1 == v or i2 == v:
                     continue
-                qx, qy, qz, _, _, _, region = closest_on_triangle(px, py, pz, pos, i0, i1, i2)
+                qx, qy, qz, b0, b1, b2, region = closest_on_triangle(px, py, pz, pos, i0, i1, i2)
                 dq = (px - qx) ** 2 + (py - qy) ** 2 + (pz - qz) ** 2
                 if dq < best:
                     best, bf, bqx, bqy, bqz = dq, f, qx, qy, qz
+                    bb0, bb1, bb2 = b0, b1, b2
                     # Corner u is corners[j] % 3; the rim is the edge opposite it and its two far corners.
                     ku = corners[j] % 3
                     rim_edge = 4 + (ku + 1) % 3  # edge codes 4, 5, 6: edges 01, 12, 20
@@ -593,6 +603,9 @@ def layer_moves(
         if side > (0.5 * abs(h) + 1e-3) ** 2:
             continue
         s = 1.0 if lv > face_layer[bf] else -1.0
+        out_face[qi] = bf
+        out_bary[qi, 0], out_bary[qi, 1], out_bary[qi, 2] = bb0, bb1, bb2
+        out_normal[qi, 0], out_normal[qi, 1], out_normal[qi, 2] = s * nx, s * ny, s * nz
         short = gap - s * h
         if short <= 0.0:
             continue

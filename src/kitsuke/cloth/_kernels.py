@@ -332,12 +332,14 @@ def limit_strain(order, n_order, rank, movable, adj_ptr, adj, adj_edge, rest_len
 
 
 @njit(cache=True)
-def project_lengths(pos, edges, rest_lengths, movable, order, omega):
+def project_lengths(pos, edges, rest_lengths, movable, order, omega, band):
     """One Gauss-Seidel sweep (in place on pos (V, 3)): each edge in `order` moves its movable ends, half each
     (all of it for one movable end), along the edge until it has its rest length, times `omega` (1: exactly;
-    1 < omega < 2: over-relaxed, past it). Returns the largest length error met in the sweep, metres (before its
-    correction). Sequential on purpose: each projection sees the previous ones, which is what makes a sweep
-    converge where a Jacobi average would cancel itself out.
+    1 < omega < 2: over-relaxed, past it). With `band` > 0 (a strain, e.g. 0.045) an edge within band * rest of
+    its rest length is left alone and one outside is moved to the nearer end of the band instead (a strain
+    limit). Returns the largest length error met in the sweep, metres (before its correction; beyond the band).
+    Sequential on purpose: each projection sees the previous ones, which is what makes a sweep converge where a
+    Jacobi average would cancel itself out.
     """
     worst = 0.0
     for o in range(len(order)):
@@ -352,6 +354,13 @@ def project_lengths(pos, edges, rest_lengths, movable, order, omega):
         if d * d < TINY2:
             continue
         err = d - rest_lengths[e]
+        slack = band * rest_lengths[e]
+        if err > slack:
+            err -= slack
+        elif err < -slack:
+            err += slack
+        else:
+            continue
         worst = max(worst, abs(err))
         f = omega * err / (d * (wa + wb))
         pos[a, 0] += wa * f * dx

@@ -52,7 +52,7 @@ class ClothParams:
     #: upper slope). On steeper surfaces the cloth hangs from what is above instead.
     support_normal_y: float = 0.5
     #: Distance the cloth is kept outside the body surface, metres. Also the depth of cloth considered "inside".
-    contact_offset_m: float = 0.003
+    contact_offset_m: float = 0.001
     #: A vertex closer to the body than this (metres) touches it: friction applies, and it supports hanging cloth.
     contact_distance_m: float = 0.006
     #: Below this distance to the body (metres) the incremental nearest-point walk is trusted; above it a global

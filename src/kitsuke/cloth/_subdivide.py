@@ -274,9 +274,9 @@ def refine(
     select : (F,) bool faces to split; default: the active faces touching an edge that `colliding_edges` flags
         (with a collider, the contacts are tracked first). Faces at `max_level` or deeper are not chosen.
     level, pending : the bookkeeping of a previous refinement (Refinement.level / .pending), default none.
-    The other attributes are carried as in `sqrt3_split`. Returns the new model (same params), the new state
-    (positions, pins and contacts carried; new vertices free and tracked from their triangle's first corner) and
-    the Refinement (whose vertex_data also holds "positions").
+    The other attributes are carried as in `sqrt3_split`. Returns the new model (same params, and the same layers:
+    each face keeps its parent's), the new state (positions, pins and contacts carried; new vertices free and
+    tracked from their triangle's first corner) and the Refinement (whose vertex_data also holds "positions").
     """
     state.check(model)
     if collider is not None:
@@ -298,6 +298,8 @@ def refine(
     sel = sel & (lev < max_level)
     vd = {"positions": state.positions, **(vertex_data or {})}
     fd = {"_active": state.face_active, **(face_data or {})}
+    if model.face_layer is not None:
+        fd["_layer"] = model.face_layer
     r = sqrt3_split(
         model.faces,
         model.rest_corners,
@@ -310,7 +312,9 @@ def refine(
         corner_data=corner_data,
     )
     active = r.face_data.pop("_active")
-    new_model = ClothModel(r.faces, r.rest_corners, model.params, r.n_vertices)
+    # A split face stays in its parent's layer (the kimono's fronts keep their order once refined).
+    layer = r.face_data.pop("_layer", None)
+    new_model = ClothModel(r.faces, r.rest_corners, model.params, r.n_vertices, layer)
     first_corner = model.faces[r.new_vertex_face, 0]
     index = np.concatenate([np.arange(model.n_vertices), first_corner])
     new_state = ClothState(
