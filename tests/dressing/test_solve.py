@@ -25,7 +25,9 @@ def cap_on_sphere(shrink: float):
     sphere (a cap wants to be flat)."""
     uv, f = grid_sheet(16, 16, 0.01)
     uv = uv - uv.mean(axis=0)
-    model = ClothModel.from_flat(f, uv, params=ClothParams())
+    # 3 mm off the body, where collision after the solve fights it hardest (at ClothParams' 1 mm the two end
+    # within 2 % of each other: 0.559 % / 0.567 % mean strain).
+    model = ClothModel.from_flat(f, uv, params=ClothParams(contact_offset_m=0.003))
     p = np.c_[uv[:, 0], np.full(len(uv), 0.1), uv[:, 1]] * (1 - shrink)
     p = p / np.linalg.norm(p, axis=1, keepdims=True) * 0.104
     return model, p

@@ -16,7 +16,8 @@ the dressed garment's surface. Steps:
 3. The global closing relaxation (`_solve.GlobalRelax`, body contacts inside the solve) with the stroke
    triangles and the pins held, then a short gravity settle (the strokes still held unless `release_strokes`),
    with edge-length restoration (`kitsuke.cloth.restore_lengths`) before and after it, and `kitsuke.cloth.untangle`
-   opens the triangles left folded (the pins and strokes still held).
+   opens the triangles left folded (the pins and strokes still held); the wrap's polish ends it (kept where it
+   is better, `_polish_step`).
 """
 
 from __future__ import annotations
@@ -45,6 +46,7 @@ from ..metrics import QualityReport, quality_report
 from ._crossing import segments_cross_triangles
 from ._drag_field import follow_weights
 from ._place import RESIDUAL_SAMPLES, body_path, lay_along, locate_in_triangles, polyline_distance
+from ._polish_step import PolishSettings, polish_step
 from ._polyline import resample_polyline
 from ._solve import GlobalRelax
 from .export import GarmentFile, as_garment_file
@@ -67,6 +69,8 @@ class RewrapParams:
     length_sweeps : sweeps of `kitsuke.cloth.restore_lengths` before and after the settle, pins and held strokes
         kept (see WrapParams).
     untangle_rounds : most rounds of `kitsuke.cloth.untangle` at the end (see WrapParams).
+    polish_rounds : rounds of the wrap's polish after that (`_polish_step`, without refinement), kept only where
+        it lowers the max strain with nothing folded (0: none).
     cloth : ClothParams of the relaxation.
     """
 
@@ -77,6 +81,7 @@ class RewrapParams:
     contact_weight: float = 20.0
     length_sweeps: int = 300
     untangle_rounds: int = 10
+    polish_rounds: int = 8
     cloth: ClothParams = field(default_factory=lambda: ClothParams(max_stretch=None))
 
     def __post_init__(self) -> None:
@@ -86,10 +91,11 @@ class RewrapParams:
             and self.settle_iterations >= 0
             and self.untangle_rounds >= 0
             and self.length_sweeps >= 0
+            and self.polish_rounds >= 0
         ):
             raise InputError(
                 "rewrap parameters lift_m >= 0, close_iterations >= 1, settle_iterations >= 0, "
-                "untangle_rounds >= 0, length_sweeps >= 0 required"
+                "untangle_rounds >= 0, length_sweeps >= 0, polish_rounds >= 0 required"
             )
         if not self.contact_weight >= 0:
             raise InputError("rewrap parameter contact_weight must be >= 0")
@@ -274,6 +280,13 @@ def rewrap(
             loose[model.faces[folded].reshape(-1)] = True
             state.pinned = state.pinned & ~(loose & ~pinned)
             untangle(model, state, collider, rounds=p.untangle_rounds)
+    if p.polish_rounds:
+        # The wrap's last step, without refinement (the garment keeps its vertices); pins and held strokes held.
+        kept, polished = polish_step(
+            model, state, collider, PolishSettings(rounds=p.polish_rounds, untangle_rounds=p.untangle_rounds)
+        )
+        if kept:
+            state = polished.state
     state.positions[pinned] = g.positions[pinned]  # exactly still
     timings["relax"] = time.perf_counter() - t2
     timings["rewrap"] = time.perf_counter() - t0

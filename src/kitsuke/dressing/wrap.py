@@ -32,11 +32,14 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
 6. **Untangle** (`kitsuke.cloth.untangle`, also run at the end of step 3, before a hold band is pinned):
    triangles still folded over their neighbours are opened by relaxing only a few rings of cloth around them,
    the rest of the garment held still (`untangle_rounds`); the stroke tethers still apply.
-7. **Polish** (`kitsuke.cloth.polish`): an L-BFGS minimisation of one energy over the garment (edge springs with
-   a barrier past 2 % strain, quadratic bending, contact planes, the stroke tethers) lets compressed cloth buckle
-   into wrinkles and spreads stretch, then the untangle opens what it folded. The result is kept only where it
-   is better: lower max strain, and mean strain, stroke residual and folds no worse than before or than the
-   targets (1 %, 10 mm, none) (`polish_rounds`; see `_polish_is_better`).
+7. **Polish** (`kitsuke.cloth.polish_refined`, through `_polish_step`): an L-BFGS minimisation of one energy over
+   the garment (edge springs with a barrier past 2 % strain, quadratic bending, contact planes, the stroke
+   tethers, the layer order) lets compressed cloth buckle into wrinkles and spreads stretch; strain-limit sweeps
+   then pull the few edges it left over 4.5 % back to it; where triangles are left folded, the cloth around them
+   is refined (adaptive sqrt(3), up to `polish_refine_levels`) and polished again, so the crease becomes a
+   wrinkle of finer triangles; the untangle opens what is still folded. The result is kept only where it is
+   better: lower max strain, and mean strain, stroke residual and folds no worse than before or than the targets
+   (1 %, 10 mm, none). A refined garment has more faces than its pattern mesh (`DressedGarment.faces`).
 
 Layered cloth (a pattern's `meta["layers"]`: the kimono's left front over its right, SPEC §5.4) keeps its layer
 order in every collision update of every step (`kitsuke.cloth.keep_layers`), so the fronts never grow or settle
@@ -57,19 +60,18 @@ from ..cloth import (
     ClothParams,
     ClothState,
     Tethers,
-    folded_faces,
-    polish_refined,
     relax,
     restore_lengths,
     untangle,
 )
 from ..errors import InputError
 from ..geometry import TriMesh
-from ..metrics import QualityReport, quality_report, strain
+from ..metrics import QualityReport, quality_report
 from ..pattern import Pattern, PatternMesh, face_layers, mesh_pattern
 from ._grow import grow
 from ._mend import MendStats, mend_tears
 from ._place import StrokeTrack, place_strokes
+from ._polish_step import PolishSettings, polish_step
 from ._refined import pieces_contiguous, remap_track
 from ._solve import GlobalRelax, gravity_settle
 from ._weld import repair_corners, weld
@@ -406,32 +408,6 @@ def _band_held(body, mesh: TriMesh, state: ClothState, band: tuple[float, float]
     return held
 
 
-#: What the polish must not make worse than this, if it was better (the issue's targets: mean strain 1 %, stroke
-#: residual 1 cm).
-POLISH_MEAN_STRAIN = 0.01
-POLISH_RESIDUAL_M = 0.01
-
-
-def _polish_is_better(
-    model: ClothModel, before: ClothState, polished: ClothModel, after: ClothState, residual_of
-) -> bool:
-    """Keep the polished cloth `after` (of `polished`, refined or `model` itself) over `before` (of `model`): its
-    max edge strain is lower, nothing is folded, and its mean strain and largest stroke residual
-    (`residual_of(positions)` (S,) metres) are no worse than before or than the targets, whichever is larger.
-    (GarmentCode's shirt: the polish lowers the max 30 -> 11 % but folds three triangles, and opening them raises
-    it to 34 %; its mean strain rises 0.8 -> 1.4 %.)"""
-
-    sb = strain(before.positions, model.edges, model.rest_lengths)
-    sa = strain(after.positions, polished.edges, polished.rest_lengths)
-    rb, ra = residual_of(before.positions).max(initial=0.0), residual_of(after.positions).max(initial=0.0)
-    return bool(
-        sa.max < sb.max
-        and not folded_faces(polished, after).any()
-        and sa.mean <= max(sb.mean, POLISH_MEAN_STRAIN)
-        and ra <= max(rb, POLISH_RESIDUAL_M)
-    )
-
-
 def wrap(
     body,
     garment: Pattern | PatternMesh,
@@ -642,31 +618,30 @@ def wrap(
     polished = False
     out_model, piece_faces, corner_uv, tracks = settle, welded.piece_faces, welded.rest_corners, placement.tracks
     if p.polish_rounds:
-        trial = state.copy()
-        trial.pinned = unheld
-        rp = polish_refined(
+        state.pinned = unheld
+        polished, rp = polish_step(
             settle,
-            trial,
+            state,
             collider,
-            rounds=p.polish_rounds,
-            iterations=p.polish_iterations,
-            levels=p.polish_refine_levels,
-            rings=p.polish_refine_rings,
-            refine_iterations=p.polish_refine_iterations,
-            strain_limit=p.polish_strain_limit,
-            limit_sweeps=p.polish_limit_sweeps,
+            PolishSettings(
+                rounds=p.polish_rounds,
+                iterations=p.polish_iterations,
+                levels=p.polish_refine_levels,
+                rings=p.polish_refine_rings,
+                refine_iterations=p.polish_refine_iterations,
+                strain_limit=p.polish_strain_limit,
+                limit_sweeps=p.polish_limit_sweeps,
+                untangle_rounds=p.untangle_rounds,
+                untangle_bend=p.untangle_bend,
+            ),
             tethers=tethers,
             corner_data={"uv": welded.rest_corners},
+            residual_of=residual_of,
         )
-        trial = rp.state
-        if p.untangle_rounds:
-            untangle(
-                rp.model, trial, collider, rounds=p.untangle_rounds, bend_stiffness=p.untangle_bend, tethers=tethers
-            )
-        trial.pinned = np.concatenate([pins, np.zeros(rp.model.n_vertices - len(pins), dtype=bool)])
-        polished = _polish_is_better(settle, state, rp.model, trial, residual_of)
+        state.pinned = pins
         if polished:
-            state = trial
+            state = rp.state
+            state.pinned = np.concatenate([pins, np.zeros(rp.model.n_vertices - len(pins), dtype=bool)])
             if rp.levels:
                 ordered = pieces_contiguous(rp, welded.piece_faces)
                 state.face_active = state.face_active[ordered.order]
