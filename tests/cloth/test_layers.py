@@ -166,3 +166,49 @@ def test_keep_layers_holds_pins_and_inactive_faces(rng):
     state = ClothState.new(model, pos.copy())
     collide(model, state, far)
     assert not np.allclose(state.positions, pos)
+
+
+def test_layer_planes_are_keep_layers_own_constraints(rng):
+    """layer_planes: every upper-sheet vertex over the lower sheet (and lower-sheet vertex under the upper one)
+    gets the plane keep_layers holds it to: a unit normal pointing out (+z) for the upper layer and in (-z) for the
+    lower one, and a point on the other layer's face (its barycentric coordinates sum to 1); the vertices
+    keep_layers moves are exactly those whose plane is violated (height along the normal under the gap)."""
+    from kitsuke.cloth import layer_planes
+
+    model, pos = two_sheets(rng, over_z=-0.002, noise=0.003)
+    state = ClothState.new(model, pos.copy())
+    planes = layer_planes(model, state)
+    assert len(planes.vertex) > 60
+    np.testing.assert_allclose(np.linalg.norm(planes.normal, axis=1), 1.0, atol=1e-12)
+    upper = model.vertex_layer[planes.vertex] == 2
+    assert upper.any() and (~upper).any()
+    assert (planes.normal[upper, 2] > 0.8).all() and (planes.normal[~upper, 2] < -0.8).all()  # noisy sheets
+    assert (model.face_layer[planes.face] != model.vertex_layer[planes.vertex]).all()
+    np.testing.assert_allclose(planes.bary.sum(axis=1), 1.0, atol=1e-12)
+    q = np.einsum("jk,jkc->jc", planes.bary, pos[model.faces[planes.face]])
+    h = np.einsum("jc,jc->j", pos[planes.vertex] - q, planes.normal)
+    violated = planes.vertex[h < model.params.layer_gap_m - 1e-12]
+    keep_layers(model, state)
+    moved = np.flatnonzero(np.abs(state.positions - pos).sum(axis=1) > 0)
+    np.testing.assert_array_equal(np.sort(violated), moved)
+
+
+def test_layer_planes_of_a_model_without_layers_are_empty():
+    from kitsuke.cloth import layer_planes
+
+    uv, f = grid_sheet(4, 3, 0.02)
+    model = ClothModel.from_flat(f, uv)
+    planes = layer_planes(model, ClothState.new(model, np.c_[uv, np.zeros(len(uv))]))
+    assert len(planes.vertex) == len(planes.face) == len(planes.bary) == len(planes.normal) == 0
+
+
+def test_refine_keeps_each_face_in_its_parents_layer(rng):
+    from kitsuke.cloth import refine
+
+    model, pos = two_sheets(rng)
+    state = ClothState.new(model, pos)
+    select = np.zeros(model.n_faces, dtype=bool)
+    select[[5, 6, 7, model.n_faces - 3]] = True
+    finer, _, r = refine(model, state, select=select)
+    assert finer.n_faces > model.n_faces
+    np.testing.assert_array_equal(finer.face_layer, model.face_layer[r.parent_face])

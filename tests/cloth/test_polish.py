@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kitsuke.cloth import BodyCollider, ClothState, Tethers, bending_matrix, folded_faces, polish
-from kitsuke.cloth._polish import plane_energy, stretch_energy, tether_energy
+from kitsuke.cloth import BodyCollider, ClothState, Tethers, bending_matrix, folded_faces, polish, polish_refined
+from kitsuke.cloth._polish import layer_energy, plane_energy, stretch_energy, tether_energy
 from kitsuke.errors import InputError
 from kitsuke.metrics import strain
 
@@ -150,3 +150,104 @@ def test_bad_arguments_are_rejected():
         WrapParams(polish_iterations=0)
     with pytest.raises(InputError):
         WrapParams(polish_rounds=-1)
+    for bad in (dict(polish_refine_levels=-1), dict(polish_refine_iterations=0), dict(polish_limit_sweeps=-1)):
+        with pytest.raises(InputError, match="polish"):
+            WrapParams(**bad)
+    for limit in (-0.01, 1.0, float("nan")):
+        with pytest.raises(InputError, match="polish_strain_limit"):
+            WrapParams(polish_strain_limit=limit)
+    with pytest.raises(InputError, match="levels"):
+        polish_refined(model, state, floor_collider(), levels=-1)
+    with pytest.raises(InputError, match="strain_limit"):
+        polish_refined(model, state, floor_collider(), strain_limit=2.0)
+
+
+def test_layer_energy_matches_numpy_and_its_gradient_is_exact():
+    """Each layered vertex's penalty for lying less than the gap along its normal from its point on the other
+    layer's face; the face's corners share the gradient by their barycentric weights."""
+    model, _, x = wobbled_sheet(3)
+    rng = np.random.default_rng(4)
+    vertex = np.array([0, 7, 12, 19], dtype=np.int64)
+    tri = np.ascontiguousarray(model.faces[[5, 9, 2, 14]])
+    bary = rng.dirichlet(np.ones(3), size=4)
+    normals = rng.normal(size=(4, 3))
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    gap, weight = 0.004, 50.0
+
+    def numpy_energy(xx):
+        q = np.einsum("jk,jkc->jc", bary, xx[tri])
+        h = np.einsum("jc,jc->j", xx[vertex] - q, normals)
+        return weight * (np.maximum(gap - h, 0.0) ** 2).sum()
+
+    g = np.zeros_like(x)
+    total = layer_energy(x, vertex, tri, bary, normals, gap, weight, g)
+    assert total == pytest.approx(numpy_energy(x), rel=1e-12) and total > 0
+    np.testing.assert_allclose(g, numeric_gradient(numpy_energy, x), atol=1e-6)
+
+
+def test_polish_keeps_squeezed_layers_in_order():
+    """Two layered sheets lying on a floor, the upper one 2 mm over the lower, both squeezed to 90 %: the polish
+    buckles them and, with the layers in its energy, the upper sheet stays over the lower one wherever it lies
+    above it (no vertex more than half a millimetre under)."""
+    from kitsuke.cloth import ClothModel, ClothParams, grid_sheet
+
+    uv, f = grid_sheet(9, 9, 0.02)
+    nv = len(uv)
+    faces = np.concatenate([f, f + nv])
+    layer = np.r_[np.ones(len(f), dtype=np.int8), np.full(len(f), 2, dtype=np.int8)]
+    model = ClothModel.from_corners(faces, np.concatenate([uv[f], uv[f]]), params=ClothParams(), face_layer=layer)
+    lower = np.c_[uv * 0.9, np.full(nv, 0.0012)]
+    upper = np.c_[uv * 0.9 + 0.004, np.full(nv, 0.0032)]
+    pos = np.concatenate([lower, upper])
+    pos[:, 2] += np.random.default_rng(5).normal(scale=2e-4, size=len(pos))
+    state = ClothState.new(model, pos)
+    polish(model, state, floor_collider(), rounds=6, iterations=60)
+    x = state.positions
+    assert x[:, 2].max() > 0.006  # they buckled
+    import igl
+
+    under = faces[layer == 1]
+    top = np.arange(nv, 2 * nv)
+    d2, fi, cp = igl.point_mesh_squared_distance(x[top], x, under)
+    n = np.cross(x[under[fi, 1]] - x[under[fi, 0]], x[under[fi, 2]] - x[under[fi, 0]])
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    h = np.einsum("ij,ij->i", x[top] - cp, n)
+    over = d2 - h * h < 1e-8  # above the lower sheet, not beside it
+    assert over.sum() > 40 and h[over].min() > -5e-4
+
+
+def test_polish_refined_refines_round_a_fold_it_cannot_open():
+    """A triangle folded over its neighbours with its corners pinned: the polish cannot open it, so each level
+    refines the cloth round it; the corner data is carried exactly (here the pattern positions themselves) and each
+    new face lies where the face it came from (parent_face) lay in the pattern."""
+    model, rest = flat_sheet(8, 8, 0.02)
+    x = rest.copy()
+    x[:, 2] = 0.003
+    f = model.faces[40]
+    x[f[0]] = x[f[1]] + x[f[2]] - x[f[0]]  # corner 0 reflected over the opposite edge: folded
+    pinned = np.zeros(model.n_vertices, dtype=bool)
+    pinned[f] = True
+    state = ClothState.new(model, x, pinned=pinned)
+    assert folded_faces(model, state).any()
+    r = polish_refined(
+        model, state, floor_collider(), rounds=2, iterations=10, levels=2, corner_data={"uv": model.rest_corners}
+    )
+    assert r.levels == 2 and r.model.n_faces > model.n_faces and r.model.n_vertices > model.n_vertices
+    np.testing.assert_allclose(r.corner_data["uv"], r.model.rest_corners, atol=1e-15)
+    # Each new face lies in the face it came from or, made by an edge flip, partly in the one across that edge.
+    near = np.c_[np.arange(model.n_faces), model.face_adjacency][r.parent_face]  # (F', 4)
+    inside = np.zeros(r.model.n_faces, dtype=bool)
+    centroid = r.model.rest_corners.mean(axis=1)
+    for k in range(4):
+        tri = model.rest_corners[np.maximum(near[:, k], 0)]
+        e1, e2, d = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0], centroid - tri[:, 0]
+        det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+        u = (d[:, 0] * e2[:, 1] - d[:, 1] * e2[:, 0]) / det
+        v = (e1[:, 0] * d[:, 1] - e1[:, 1] * d[:, 0]) / det
+        inside |= (near[:, k] >= 0) & (np.minimum(np.minimum(u, v), 1 - u - v) > -1e-9)
+    assert inside.all()
+    np.testing.assert_array_equal(r.state.positions[f], x[f])  # pins held
+    assert len(r.state.pinned) == r.model.n_vertices and not r.state.pinned[model.n_vertices :].any()
+    # Without levels nothing is refined.
+    r0 = polish_refined(model, ClothState.new(model, x, pinned=pinned), floor_collider(), rounds=1, levels=0)
+    assert r0.levels == 0 and r0.model is model

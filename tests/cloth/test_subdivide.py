@@ -165,3 +165,14 @@ def test_sqrt3_rejects_bad_input():
         sqrt3_split(f, uv[f], np.ones(3, dtype=bool))
     with pytest.raises(InputError, match="positions"):
         sqrt3_split(f, uv[f], np.ones(len(f), dtype=bool), vertex_data={"positions": np.zeros((2, 3))})
+
+
+def test_one_face_with_corner_data_splits_without_flips():
+    """A single selected face has no partner at its level: it is split 1-to-3 and nothing flips, and its corner
+    data is carried all the same (an empty list of flip candidates once failed to reshape)."""
+    uv, f = grid_sheet(4, 4, 0.02)
+    select = np.zeros(len(f), dtype=bool)
+    select[7] = True
+    r = sqrt3_split(f, uv[f], select, corner_data={"uv": uv[f] * 2.0})
+    assert r.flipped == 0 and len(r.faces) == len(f) + 2
+    np.testing.assert_allclose(r.corner_data["uv"], r.rest_corners * 2.0)

@@ -308,5 +308,11 @@ def test_bad_input_raises_and_leaves_the_garment_unchanged(body, skirt, collider
         DragParams(contact_iterations=0)
     with pytest.raises(InputError, match="contact_weight"):
         DragParams(contact_weight=float("nan"))
+    with pytest.raises(InputError, match="release_polish_rounds"):
+        DragParams(release_polish_rounds=-1)
+    with pytest.raises(InputError, match="release_polish_iterations"):
+        DragParams(release_polish_iterations=0)
+    with pytest.raises(InputError, match="release_polish_above"):
+        DragParams(release_polish_above=float("nan"))
     with pytest.raises(InputError):
         DragSession(body, "not a garment")

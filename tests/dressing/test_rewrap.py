@@ -95,6 +95,8 @@ def test_rewrap_bad_input(body, dressed):
         rewrap(body, dressed, far)
     with pytest.raises(InputError, match="length_sweeps"):
         RewrapParams(length_sweeps=-1)
+    with pytest.raises(InputError, match="polish_rounds"):
+        RewrapParams(polish_rounds=-1)
 
 
 def test_cli_rewrap_writes_obj_and_report_and_refuses_bad_pins(run_cli, tmp_path, body, dressed):

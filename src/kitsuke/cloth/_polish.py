@@ -313,8 +313,9 @@ class RefinedPolish:
     """What `polish_refined` made: the cloth after the polish, finer where it had folded.
 
     model, state : the refined cloth (old vertices keep their indices, new ones follow; the faces are new).
-    parent_face : (F',) int64, the face of the input model each face lies in (a flipped pair: the face of its first
-    corner). corner_data : the per-corner attributes given, carried onto the new faces. levels : sqrt(3) levels run.
+    parent_face : (F',) int64, the face of the input model each face came from (it lies in it or, made by an edge
+    flip, partly in the face across that edge; never in another piece: seams do not flip). corner_data : the
+    per-corner attributes given, carried onto the new faces. levels : sqrt(3) levels run.
     stats : the first polish's PolishStats, with the later polishes' rounds and iterations added.
     """
 

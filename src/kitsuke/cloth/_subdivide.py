@@ -210,8 +210,9 @@ def _split_stage(faces, rc, stage, nv, level, pending, vdata, cdata):
     ok &= np.linalg.norm(new_rc[f1, 0] - new_rc[f2, 1], axis=1) <= tol
     ok &= np.linalg.norm(new_rc[f1, 1] - new_rc[f2, 0], axis=1) <= tol
     for v in new_cdata.values():
-        ok &= np.abs(v[f1, 0] - v[f2, 1]).reshape(len(f1), -1).max(axis=1, initial=0) <= 1e-9
-        ok &= np.abs(v[f1, 1] - v[f2, 0]).reshape(len(f1), -1).max(axis=1, initial=0) <= 1e-9
+        width = int(np.prod(v.shape[2:], dtype=np.int64))  # (an empty pair list cannot reshape with -1)
+        ok &= np.abs(v[f1, 0] - v[f2, 1]).reshape(len(f1), width).max(axis=1, initial=0) <= 1e-9
+        ok &= np.abs(v[f1, 1] - v[f2, 0]).reshape(len(f1), width).max(axis=1, initial=0) <= 1e-9
     # Convex rest quad: both new triangles keep the parents' orientation.
     q1 = np.stack([new_rc[f1, 0], new_rc[f2, 2], new_rc[f1, 2]], 1)
     q2 = np.stack([new_rc[f2, 2], new_rc[f1, 1], new_rc[f1, 2]], 1)
