@@ -66,6 +66,8 @@ STIFFEN_MAX = 30.0
 STIFFEN_RINGS = 2
 #: L-BFGS memory (correction pairs).
 LBFGS_MEMORY = 20
+#: After a refinement level, the polish moves the refined cloth and this many rings of cloth round it.
+LOCAL_RINGS = 3
 #: The strain limit's sweeps (`polish_refined`): a collision update after this many, and a stop once no edge is
 #: farther than LIMIT_TOLERANCE_M (metres: rounding) beyond the limit.
 LIMIT_COLLIDE_EVERY = 4
@@ -403,7 +405,13 @@ def polish_refined(
         level, pending, carried = r.level, r.pending, r.corner_data
         parent = parent[r.parent_face]
         done += 1
+        # The rest of the garment has been polished: only the refined cloth and LOCAL_RINGS rings round it move.
+        local = np.concatenate([near, np.ones(model.n_vertices - len(near), dtype=bool)])
+        local = grow_region(model.faces, local, LOCAL_RINGS)
+        held = state.pinned
+        state.pinned = held | ~local
         more = polish(model, state, collider, rounds=rounds, iterations=refine_iterations, tethers=tethers)
+        state.pinned = held
         limit(model, state)
         stats.rounds += more.rounds
         stats.iterations += more.iterations
