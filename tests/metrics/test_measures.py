@@ -177,3 +177,25 @@ def test_quality_report_rejects_bad_input(box):
         quality_report(pos[:, :2], f, box, rest_lengths=np.ones(16))
     with pytest.raises(InputError, match="body"):
         penetration(pos, "body.obj")  # type: ignore[arg-type]
+
+
+def test_wrong_side_mm_and_layer_crossing():
+    """Two layered sheets, the upper (2) 3 mm under the lower (1) over their middle: its vertices there are 3 mm on
+    the wrong side (and the lower sheet's as much on its wrong side of the upper one); moved 3 mm over, none is;
+    vertices beside the other sheet's border, or without layers, count 0."""
+    from kitsuke.cloth import grid_sheet
+    from kitsuke.metrics import layer_crossing_mm, wrong_side_mm
+
+    uv, f = grid_sheet(7, 7, 0.02)
+    nv = len(uv)
+    faces = np.concatenate([f, f + nv])
+    layer = np.r_[np.ones(len(f)), np.full(len(f), 2)].astype(np.int8)
+    lower = np.c_[uv, np.zeros(nv)]
+    upper = np.c_[uv + [0.006, 0.004], np.full(nv, -0.003)]
+    wrong = wrong_side_mm(np.concatenate([lower, upper]), faces, layer, 2, 1)
+    inner = (uv[:, 0] > 0.02) & (uv[:, 0] < 0.1) & (uv[:, 1] > 0.02) & (uv[:, 1] < 0.1)
+    np.testing.assert_allclose(wrong[inner], 3.0, atol=1e-9)
+    assert layer_crossing_mm(np.concatenate([lower, upper]), faces, layer) == pytest.approx(3.0)
+    upper[:, 2] = 0.003
+    assert layer_crossing_mm(np.concatenate([lower, upper]), faces, layer) == 0.0
+    assert layer_crossing_mm(np.concatenate([lower, upper]), faces, None) == 0.0

@@ -42,7 +42,7 @@ from ._untangle import folded_faces, grow_region
 
 #: Weight of the soft edge spring (per metre of rest length). With LIMIT_WEIGHT it sets how strain is shared:
 #: weaker springs let the mean strain rise (measured on GarmentCode's shirt: 1.8 % at 1, 1.3 % at 20).
-STRETCH_WEIGHT = 100.0
+STRETCH_WEIGHT = 1000.0
 #: Weight of the barrier past LIMIT_STRAIN: 50x the spring, so edges past it cost far more than many edges below.
 LIMIT_WEIGHT = 1000.0
 #: Strain where the barrier starts, below the issue's 5 % so that the barrier's own give stays under it.

@@ -1,10 +1,11 @@
-"""Quality measures of a dressed garment (SPEC §6): penetration, strain, seam gap, inverted triangles, and a
-JSON-ready report with pass/fail per measure against the targets of issue 3.
+"""Quality measures of a dressed garment (SPEC §6): penetration, strain, seam gap, inverted triangles, the order of
+layered cloth, and a JSON-ready report with pass/fail per measure against the targets of issue 3.
 
     report = quality_report(positions, faces, body.mesh, rest_lengths=model.rest_lengths)
     report.ok, report.failures(), report.to_dict()
 """
 
+from ._layers import layer_crossing_mm, wrong_side_mm
 from ._measures import (
     COLLAPSE_RATIO,
     Penetration,
@@ -26,9 +27,11 @@ __all__ = [
     "SeamGap",
     "Strain",
     "inverted_triangles",
+    "layer_crossing_mm",
     "mesh_edges",
     "penetration",
     "quality_report",
     "seam_gap",
     "strain",
+    "wrong_side_mm",
 ]
