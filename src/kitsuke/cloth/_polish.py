@@ -72,6 +72,8 @@ LOCAL_RINGS = 3
 #: farther than LIMIT_TOLERANCE_M (metres: rounding) beyond the limit.
 LIMIT_COLLIDE_EVERY = 4
 LIMIT_TOLERANCE_M = 1e-7
+#: Most strain-limit sweeps after each polish but the last (`polish_refined`).
+LIMIT_SWEEPS_BETWEEN = 400
 
 
 @dataclass
@@ -371,13 +373,13 @@ def polish_refined(
     if strain_limit is not None and not 0.0 <= strain_limit < 1.0:
         raise InputError(f"polish_refined needs a strain_limit in [0, 1) or None, got {strain_limit}")
 
-    def limit(model: ClothModel, state: ClothState) -> None:
-        if strain_limit is not None and limit_sweeps:
+    def limit(model: ClothModel, state: ClothState, sweeps: int) -> None:
+        if strain_limit is not None and sweeps:
             restore_lengths(
                 model,
                 state,
                 collider,
-                sweeps=limit_sweeps,
+                sweeps=sweeps,
                 band=strain_limit,
                 tethers=tethers,
                 collide_every=LIMIT_COLLIDE_EVERY,
@@ -385,8 +387,10 @@ def polish_refined(
                 search_first=True,
             )
 
+    # Between levels the limit only needs to show where it folds the cloth; the full count ends the last one.
+    between = min(limit_sweeps, LIMIT_SWEEPS_BETWEEN)
     stats = polish(model, state, collider, rounds=rounds, iterations=iterations, tethers=tethers)
-    limit(model, state)
+    limit(model, state, between)
     parent = np.arange(model.n_faces, dtype=np.int64)
     carried = {k: np.asarray(v) for k, v in (corner_data or {}).items()}
     level = pending = None
@@ -412,8 +416,10 @@ def polish_refined(
         state.pinned = held | ~local
         more = polish(model, state, collider, rounds=rounds, iterations=refine_iterations, tethers=tethers)
         state.pinned = held
-        limit(model, state)
+        limit(model, state, between)
         stats.rounds += more.rounds
         stats.iterations += more.iterations
         stats.energy, stats.folded = more.energy, more.folded
+    if limit_sweeps > between:
+        limit(model, state, limit_sweeps)
     return RefinedPolish(model, state, parent, carried, done, stats)
