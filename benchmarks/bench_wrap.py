@@ -63,7 +63,7 @@ def main() -> None:
     r = g.report
     print(
         f"quality: penetration {r.penetration_count} (deepest {r.penetration_deepest_mm:.1f} mm), strain mean "
-        f"{100 * r.strain_mean:.1f} % max {100 * r.strain_max:.0f} %, seam gap {r.seam_gap_mm} mm, inverted "
+        f"{100 * r.strain_mean:.1f} % max {100 * r.strain_max:.2f} %, seam gap {r.seam_gap_mm} mm, inverted "
         f"{r.inverted_count}, stroke residual max {1e3 * g.max_stroke_residual_m:.0f} mm"
     )
 

@@ -128,7 +128,7 @@ class DragParams:
     release_polish_rounds, release_polish_iterations : after those, the wrap's polish (`_polish_step`, without
         refinement: the garment keeps its vertices), the held cloth still held, kept only where it lowers the max
         strain with nothing folded: the drag's relaxation is tuned, not converged (measured on the skirt turned
-        30 degrees: 5.5 -> 2.4 % max strain; 0: none).
+        30 degrees: 5.5 -> 2.6 % max strain; 0: none).
     release_polish_above : the polish runs only where the max edge strain after the release is above this (issue
         3's 5 %): a drag that left the garment within the target is left as the drag made it.
     max_pick_distance_m : a grab or pin point may lie at most this far from a garment vertex, metres.

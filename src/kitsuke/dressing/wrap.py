@@ -181,21 +181,25 @@ class WrapParams:
         round, the rest of the garment untouched; the kimono: 16 -> 0 (one of them inside the obi band, which
         only the untangle after the close can reach).
     polish_rounds : rounds of `kitsuke.cloth.polish` at the end (0: none), each of up to `polish_iterations` L-BFGS
-        iterations; its result is kept only if better (see the module docstring, step 7). Measured 2026-11-25:
-        the FreeSewing T-shirt's max strain 11.6 -> 4.0 % (mean 0.38 -> 0.46 %), kept; the kimono's 41 -> 31 %,
-        kept; GarmentCode's shirt and hoody end worse after the untangle (34 %, 32 %) and keep their wrap.
-    polish_refine_levels : where the polish leaves triangles folded, up to this many adaptive sqrt(3) levels of
-        the cloth within `polish_refine_rings` rings of the folds, each polished again with up to
-        `polish_refine_iterations` L-BFGS iterations per round (`kitsuke.cloth.polish_refined`): the crease
-        becomes a wrinkle of finer triangles instead of being pressed flat by the untangle. The garment then has
-        more faces than its pattern mesh (the OBJ's `vt` still give every corner's pattern position). Measured
-        2026-11-25 on GarmentCode's hoody: 9 folded triangles after the polish, 0 after 3 levels, max strain
-        4.5 % (25 % without the polish, 32 % polished and untangled); 0: no refinement.
-    polish_strain_limit, polish_limit_sweeps : after the polish, up to this many Gauss-Seidel sweeps pull every edge
-        strained more than the limit back to it, and leave the others alone (`restore_lengths` with a band), the
-        stroke tethers and collision kept. The polish spreads strain but its barrier is soft (a stiffer one stalls
-        L-BFGS); the limit takes the few edges it left over 5 % under without the equal-length sweeps' flattening
-        of its buckles. 0 sweeps: none.
+        iterations; its result is kept only if better (see the module docstring, step 7, and `_polish_step`).
+        Measured 2026-11-25 (with everything below): mean / max strain GarmentCode's shirt 0.84 / 28.7 -> 0.77 /
+        4.6 %, hoody 0.83 / 25.3 -> 0.37 / 4.5 %, the FreeSewing T-shirt 0.38 / 11.6 -> 0.27 / 4.5 %; the kimono's
+        is not kept (its fronts pushed through each other).
+    polish_refine_levels : where the polish leaves triangles folded (at most `polish_refine_max_folds` of them), up
+        to this many adaptive sqrt(3) levels of the cloth within `polish_refine_rings` rings of the folds, each
+        polished again with up to `polish_refine_iterations` L-BFGS iterations per round (`polish_refined`): the
+        crease becomes a wrinkle of finer triangles instead of being pressed flat by the untangle. The garment then
+        has more faces than its pattern mesh (the OBJ's `vt` still give every corner's pattern position). Measured
+        2026-11-25 on GarmentCode's hoody (3 mm offset): 9 folded triangles after the polish, 0 after 3 levels, max
+        strain 4.5 % (32 % polished and untangled); 0: no refinement.
+    polish_strain_limit, polish_limit_sweeps : after each polish, up to this many Gauss-Seidel sweeps (400 between
+        refinement levels) pull every edge strained more than the limit back to it, and leave the others alone
+        (`restore_lengths` with a band), the stroke tethers and collision kept. The polish spreads strain but its
+        barrier is soft (a stiffer one stalls L-BFGS); the limit takes the few edges it left over 5 % under without
+        the equal-length sweeps' flattening of its buckles. Over 1 nm changes of the body the shirt ended at
+        4.83-5.02 % with 400 sweeps, 4.50-4.51 % with 1500. 0 sweeps: none.
+    polish_passes : most polish passes; a later one runs only while the max strain is over 5 %, from the better
+        cloth the last one kept.
     release_strokes : unpin the stroke triangles for the settle (the paper lets the garment settle freely);
         False keeps them where the strokes put them.
     hold_band_m : (low, high) heights in metres, or None: garment vertices in this band are pinned for the settle
