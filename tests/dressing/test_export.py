@@ -52,9 +52,10 @@ def test_obj_has_pattern_rest_shape_pieces_and_shared_seams(dressed):
         for v in np.unique(g.faces[a:b]):
             owner[v] = k if owner[v] in (-1, k) else -2
     assert (owner == -2).sum() > 50
-    # Rest lengths from vt are what the report's strain is measured against: positive and centimetre-sized.
+    # Rest lengths from vt are what the report's strain is measured against: positive and centimetre-sized, but
+    # where the polish refined a fold (up to 4 sqrt(3) levels: a ninth of 1.5 cm and less; measured 0.77 mm).
     rest = g.rest_edge_lengths
-    assert rest.min() > 0.001 and 0.01 < np.median(rest) < 0.02
+    assert rest.min() > 0.0002 and 0.01 < np.median(rest) < 0.02
 
 
 def test_report_glb_and_png(dressed):
