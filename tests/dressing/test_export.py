@@ -103,6 +103,24 @@ def test_dress_bad_input_is_exit_2_and_writes_nothing(run_cli, tmp_path):
     assert r.code == 2 and "--hang is for a wrap" in r.err and not out.exists()
 
 
+def test_dress_without_the_polish(run_cli, tmp_path, dressed):
+    """--no-polish: the wrap ends at its settle, so the garment keeps its pattern mesh's faces and the report
+    names the max strain the polish would have taken down; with it (the `dressed` fixture) all targets are met."""
+    out, report = tmp_path / "quick.glb", tmp_path / "quick.json"
+    r = run_cli(
+        "dress", "--body", MEAN_ALL, "--pattern", SHIRT, "--strokes", SHIRT_STROKES, "-o", out, "--report", report,
+        "--no-polish",
+    )  # fmt: skip
+    assert r.code == 0, r.err
+    quick, full = json.loads(report.read_text()), json.loads(dressed["json"].read_text())
+    assert quick["polished"] is False and full["polished"] is True
+    assert quick["faces"] < full["faces"]
+    assert quick["quality"]["strain_max"] > 0.05 >= full["quality"]["strain_max"]
+    assert "targets missed: max edge strain" in r.err and "all quality targets met" not in r.err
+    r = run_cli("dress", "--body", MEAN_ALL, "--garment", SHIRT, "--strokes", SHIRT_STROKES, "-o", out, "--no-polish")
+    assert r.code == 2 and "--no-polish is for a wrap" in r.err
+
+
 def test_dress_a_kimono_pattern_like_the_demo(run_cli, tmp_path):
     """A kimono pattern file (`kitsuke pattern kimono`) on the default body is dressed as the demo dresses it:
     sleeves hanging as bags (their lowest point far below the elbow; measured 30 / 32 cm at 2.5 cm edges, the

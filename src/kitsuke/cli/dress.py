@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 
 from ._common import add_body_options, body_from_args, checked_output
@@ -92,6 +93,13 @@ def register(parser: argparse.ArgumentParser) -> None:
         metavar="MM",
         help="how far a pattern stroke may settle from its body stroke, mm (default 8; 0: settle freely)",
     )
+    parser.add_argument(
+        "--no-polish",
+        action="store_true",
+        help="skip the wrap's last step, the polish (strain capped at 4.5 %%, finer triangles where a crease "
+        "folds): several times faster (GarmentCode's shirt 2.1 -> 0.4 s) but the max edge strain stays where "
+        "the settle left it (the shirt: 28 %% instead of 4.6 %%)",
+    )
     add_body_options(parser)
     parser.set_defaults(run=run)
 
@@ -124,6 +132,8 @@ def run(args: argparse.Namespace) -> int:
             raise InputError("--hold-strokes is for a wrap: a re-wrap (--garment) holds its strokes already")
         if args.hang is not None:
             raise InputError("--hang is for a wrap: a re-wrap (--garment) moves cloth already grown")
+        if args.no_polish:
+            raise InputError("--no-polish is for a wrap")
         return _rewrap(args, outs)
     if args.pin:
         raise InputError("--pin holds part of a dressed garment: use it with --garment (a re-wrap)")
@@ -135,6 +145,8 @@ def run(args: argparse.Namespace) -> int:
     make = WrapParams.strokes_held if args.hold_strokes else WrapParams
     reach = args.stroke_reach * 1e-3 if args.stroke_reach > 0 else None
     params = make(edge_length_cm=args.edge_length, stroke_reach_m=reach, hang=args.hang or 0.0)
+    if args.no_polish:
+        params = dataclasses.replace(params, polish_rounds=0)
     if is_kimono(pattern):
         params = kimono_params(body, params, hang=args.hang)
     garment = wrap(body, pattern, strokes, params=params)
