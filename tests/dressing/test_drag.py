@@ -239,8 +239,8 @@ def test_rough_drags_up_and_down_do_not_tear_the_coarse_kimono(body, collider):
     """The kimono at 2.5 cm (as benchmarks/bench_drag.py drags it) lifted 10 cm by its front and put back, three
     times, in 1 cm updates: its hem round the shins does not tear (206 % max strain, 2.8 % mean, when collision
     only followed the global relaxation and fought it), and the wrap's targets it met still hold. Measured
-    2026-11-25: dressed 20 % max (polished), 82 % after the release's relaxation (where the collars cross), 33 %
-    after the release's polish; mean 0.96 %."""
+    2026-11-25 (benchmarks/bench_drag.py): dressed 0.55 % / 37 %, after 0.49 % / 13 % mean / max strain (dragged
+    at the 3 mm it was dressed with; at 1 mm 0.94 % / 22 %)."""
     from kitsuke.dressing import WrapParams
     from kitsuke.dressing.kimono import dress_default_kimono
 
@@ -254,7 +254,7 @@ def test_rough_drags_up_and_down_do_not_tear_the_coarse_kimono(body, collider):
     s.release()
     after = s.report()
     assert_kimono_targets_kept(before, after)
-    assert after.strain_max < 0.4  # torn: 206 %
+    assert after.strain_max < before.strain_max + 0.1  # torn: 206 %
 
 
 # -- API behaviour and bad input ----------------------------------------------------------------------------------

@@ -117,8 +117,6 @@ def test_dress_without_the_polish(run_cli, tmp_path, dressed):
     assert quick["faces"] < full["faces"]
     assert quick["quality"]["strain_max"] > 0.05 >= full["quality"]["strain_max"]
     assert "targets missed: max edge strain" in r.err and "all quality targets met" not in r.err
-    r = run_cli("dress", "--body", MEAN_ALL, "--garment", SHIRT, "--strokes", SHIRT_STROKES, "-o", out, "--no-polish")
-    assert r.code == 2 and "--no-polish is for a wrap" in r.err
 
 
 def test_dress_a_kimono_pattern_like_the_demo(run_cli, tmp_path):

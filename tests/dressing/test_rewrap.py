@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from kitsuke.dressing import BodyStroke, PatternStroke, StrokePair, Strokes, write_strokes
+from kitsuke.dressing import BodyStroke, PatternStroke, StrokePair, Strokes, read_strokes, write_strokes
 from kitsuke.dressing._place import locate_in_triangles
 from kitsuke.dressing.export import as_garment_file, read_garment_obj, write_garment_obj
 from kitsuke.dressing.rewrap import RewrapParams, rewrap
@@ -120,3 +120,12 @@ def test_cli_rewrap_writes_obj_and_report_and_refuses_bad_pins(run_cli, tmp_path
     # --pin needs a garment
     r2 = run_cli(*args, "--pattern", garment_obj, "--pin", "0,1,0")
     assert r2.code == 2
+    # --no-polish: the re-wrap without its last step, the same garment as from Python with polish_rounds=0.
+    quick = tmp_path / "quick.obj"
+    r3 = run_cli(*args, "--garment", garment_obj, f"--pin={pin}", "--obj", quick, "--no-polish")
+    assert r3.code == 0, r3.err
+    want = rewrap(
+        body, read_garment_obj(garment_obj), read_strokes(strokes), pins=[[float(c) for c in pin.split(",")]],
+        params=RewrapParams(polish_rounds=0),
+    )  # fmt: skip
+    np.testing.assert_allclose(read_garment_obj(quick).positions, want.garment.positions, atol=2e-6)

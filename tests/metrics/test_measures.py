@@ -196,6 +196,19 @@ def test_wrong_side_mm_and_layer_crossing():
     inner = (uv[:, 0] > 0.02) & (uv[:, 0] < 0.1) & (uv[:, 1] > 0.02) & (uv[:, 1] < 0.1)
     np.testing.assert_allclose(wrong[inner], 3.0, atol=1e-9)
     assert layer_crossing_mm(np.concatenate([lower, upper]), faces, layer) == pytest.approx(3.0)
+    assert (wrong[~inner & ((uv[:, 0] > 0.115) | (uv[:, 1] > 0.115))] == 0.0).all()  # beside the lower sheet
     upper[:, 2] = 0.003
     assert layer_crossing_mm(np.concatenate([lower, upper]), faces, layer) == 0.0
     assert layer_crossing_mm(np.concatenate([lower, upper]), faces, None) == 0.0
+
+
+def test_wrong_side_mm_skips_vertices_between_layers():
+    """A vertex whose faces belong to two layers is in neither (however the faces list it)."""
+    from kitsuke.metrics import wrong_side_mm
+
+    pos = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, -0.001]], dtype=float) * 0.01
+    faces = np.array([[0, 1, 2], [0, 2, 3], [4, 0, 3]])
+    layer = np.array([1, 2, 1], dtype=np.int8)
+    # Vertex 3 has a face of layer 2 and one of layer 1: not counted as layer 1's (only vertices 1 and 4 are).
+    assert len(wrong_side_mm(pos, faces, layer, 1, 2)) == 2
+    assert len(wrong_side_mm(pos, faces, layer, 2, 1)) == 0

@@ -333,7 +333,8 @@ class LayerPlanes:
 
 
 def _layer_search(model: ClothModel, state: ClothState, movable: np.ndarray | None):
-    """keep_layers' search: (query vertices, moves, faces, barycentrics, normals), or None with nothing to do."""
+    """keep_layers' search: (query vertices, moves, faces, barycentrics, normals, number moved), or None with
+    nothing to do."""
     if model.face_layer is None:
         return None
     p = model.params
@@ -349,7 +350,7 @@ def _layer_search(model: ClothModel, state: ClothState, movable: np.ndarray | No
     origin, cell, dims, ptr, items = K.point_grid(pos, others, model.layer_cell_m, 8 * len(others))
     move, face = np.empty((len(query), 3)), np.empty(len(query), dtype=np.int64)
     bary, normal = np.empty((len(query), 3)), np.empty((len(query), 3))
-    K.layer_moves(
+    moved = K.layer_moves(
         pos,
         model.faces,
         model.face_layer,
@@ -376,7 +377,7 @@ def _layer_search(model: ClothModel, state: ClothState, movable: np.ndarray | No
         bary,
         normal,
     )
-    return query, move, face, bary, normal
+    return query, move, face, bary, normal, int(moved)
 
 
 def layer_planes(model: ClothModel, state: ClothState, movable: np.ndarray | None = None) -> LayerPlanes:
@@ -387,7 +388,7 @@ def layer_planes(model: ClothModel, state: ClothState, movable: np.ndarray | Non
     found = _layer_search(model, state, movable)
     if found is None:
         return LayerPlanes.empty()
-    query, _, face, bary, normal = found
+    query, _, face, bary, normal, _ = found
     k = face >= 0
     return LayerPlanes(query[k], face[k], bary[k], normal[k])
 
@@ -402,9 +403,9 @@ def keep_layers(model: ClothModel, state: ClothState, movable: np.ndarray | None
     found = _layer_search(model, state, movable)
     if found is None:
         return 0
-    query, move = found[:2]
+    query, move, moved = found[0], found[1], found[5]
     state.positions[query] += move
-    return int((move != 0.0).any(axis=1).sum())
+    return moved
 
 
 def collide(model: ClothModel, state: ClothState, collider: BodyCollider) -> CollisionStats:

@@ -8,7 +8,7 @@ a hood gathered at the neck), and cloth pulled between two contacts stays stretc
 The energy, per round, with the body's contact planes and the stroke tethers' nearest points held fixed:
 
 - stretch: sum over edges of L (STRETCH_WEIGHT s^2 + LIMIT_WEIGHT max(|s| - LIMIT_STRAIN, 0)^2), s = l / L - 1
-  (L the rest length): a stiff quadratic barrier past LIMIT_STRAIN on top of a soft spring;
+  (L the rest length): a quadratic spring and, past LIMIT_STRAIN, a barrier of the same stiffness on top;
 - bending: x^T Q x with Q the quadratic bending matrix (Bergou et al. 2006, "A quadratic bending model for
   inextensible surfaces"): per hinge, the cotangent-weighted combination of its four vertices that vanishes
   while the hinge is flat, squared; constant, so its gradient is 2 Q x;
@@ -40,10 +40,12 @@ from ._subdivide import refine
 from ._tethers import Tethers
 from ._untangle import folded_faces, grow_region
 
-#: Weight of the soft edge spring (per metre of rest length). With LIMIT_WEIGHT it sets how strain is shared:
-#: weaker springs let the mean strain rise (measured on GarmentCode's shirt: 1.8 % at 1, 1.3 % at 20).
+#: Weight of the edge spring (per metre of rest length). With LIMIT_WEIGHT it sets how strain is shared: weaker
+#: springs let the mean strain rise (GarmentCode's shirt polished and refined: 0.99 / 0.85 / 0.76 % at 100 / 300 /
+#: 1000; before the refinement 1.8 % at 1, 1.3 % at 20).
 STRETCH_WEIGHT = 1000.0
-#: Weight of the barrier past LIMIT_STRAIN: 50x the spring, so edges past it cost far more than many edges below.
+#: Weight of the barrier past LIMIT_STRAIN, on top of the spring: edges past it cost twice as much per unit of
+#: strain squared. (The strain limit after the polish, not this barrier, keeps edges under 4.5 %.)
 LIMIT_WEIGHT = 1000.0
 #: Strain where the barrier starts, below the issue's 5 % so that the barrier's own give stays under it.
 LIMIT_STRAIN = 0.02
@@ -319,8 +321,11 @@ class RefinedPolish:
     model, state : the refined cloth (old vertices keep their indices, new ones follow; the faces are new).
     parent_face : (F',) int64, the face of the input model each face came from (it lies in it or, made by an edge
     flip, partly in the face across that edge; never in another piece: seams do not flip). corner_data : the
-    per-corner attributes given, carried onto the new faces. levels : sqrt(3) levels run.
-    stats : the first polish's PolishStats, with the later polishes' rounds and iterations added.
+    per-corner attributes given, carried onto the new faces. levels : refinement steps run (a face is split at
+    most `refine`'s max_level times in all).
+    stats : the first polish's PolishStats, with the later polishes' rounds and iterations added (energy and
+    folded: the last polish's). level, pending : the refinement's bookkeeping per face (`Refinement.level`,
+    `.pending`), None if nothing was refined: pass them to a later `polish_refined` of the same cloth.
     """
 
     model: ClothModel
@@ -329,6 +334,8 @@ class RefinedPolish:
     corner_data: dict[str, np.ndarray]
     levels: int
     stats: PolishStats
+    level: np.ndarray | None = None
+    pending: np.ndarray | None = None
 
 
 def polish_refined(
@@ -346,10 +353,13 @@ def polish_refined(
     tethers: Tethers | None = None,
     corner_data: dict[str, np.ndarray] | None = None,
     max_folds: int = 20,
+    level: np.ndarray | None = None,
+    pending: np.ndarray | None = None,
 ) -> RefinedPolish:
     """`polish`, then, while triangles are left folded, up to `levels` adaptive sqrt(3) steps (`refine`) on the
     faces within `rings` rings of the folds, each followed by a polish of `rounds` rounds of up to
-    `refine_iterations` L-BFGS iterations. `state` is polished in place; the refined cloth is returned.
+    `refine_iterations` L-BFGS iterations. `state` is polished in place until the first refinement; the cloth at
+    the end (refined or not) is the one returned.
 
     Why: at 1.5 cm edges the cloth the body has no room for (a hood gathered at the neck) buckles into creases
     of a triangle or two, folded over their neighbours; opening them (`untangle`) presses the cloth flat again
@@ -357,19 +367,24 @@ def polish_refined(
     that folds nothing (GarmentCode's hoody on mean_all: 9 folded triangles and 5.9 % max strain after the
     polish; 0 folded and 4.5 % after three levels, 6,300 -> 6,700 faces).
 
-    strain_limit : a strain (e.g. 0.045) or None. After each polish, up to `limit_sweeps` Gauss-Seidel sweeps pull
+    strain_limit : a strain (e.g. 0.045) or None. After each polish, up to LIMIT_SWEEPS_BETWEEN (after the last
+        one `limit_sweeps`) Gauss-Seidel sweeps pull
         every edge strained more than this back to it and leave the others alone (`restore_lengths` with a band,
         searching the body afresh first, the tethers held): the polish's barrier is soft (a stiffer one stalls
         L-BFGS) and this takes the few edges it left over the limit under it without the equal-length sweeps'
         flattening of its buckles. The folds looked for are those left after it.
+    level, pending : a previous `polish_refined`'s RefinedPolish.level / .pending of this cloth, so that its faces
+        are not split past `refine`'s max_level nor its pending flips lost (None: unrefined cloth).
     max_folds : refine only while at most this many triangles are folded: refinement rounds off a few creases;
         cloth crumpled in many places is left to the untangle (measured on the demo kimono, 36 folds after the
         polish, most in its hanging sleeves and skirt: five levels of refinement there ended at 465 % max strain).
     Tether points keep the corners they were given on (old vertices keep their indices), so `tethers` hold on
     the refined cloth as they did. corner_data : {name: (F, 3, ...) array} carried like the rest corners.
     """
-    if levels < 0 or rings < 0 or refine_iterations < 1 or limit_sweeps < 0:
-        raise InputError("polish_refined needs levels >= 0, rings >= 0, refine_iterations >= 1, limit_sweeps >= 0")
+    if levels < 0 or rings < 0 or refine_iterations < 1 or limit_sweeps < 0 or max_folds < 0:
+        raise InputError(
+            "polish_refined needs levels >= 0, rings >= 0, refine_iterations >= 1, limit_sweeps >= 0, max_folds >= 0"
+        )
     if strain_limit is not None and not 0.0 <= strain_limit < 1.0:
         raise InputError(f"polish_refined needs a strain_limit in [0, 1) or None, got {strain_limit}")
 
@@ -393,7 +408,6 @@ def polish_refined(
     limit(model, state, between)
     parent = np.arange(model.n_faces, dtype=np.int64)
     carried = {k: np.asarray(v) for k, v in (corner_data or {}).items()}
-    level = pending = None
     done = 0
     for _ in range(levels):
         folded = folded_faces(model, state)
@@ -422,4 +436,4 @@ def polish_refined(
         stats.energy, stats.folded = more.energy, more.folded
     if limit_sweeps > between:
         limit(model, state, limit_sweeps)
-    return RefinedPolish(model, state, parent, carried, done, stats)
+    return RefinedPolish(model, state, parent, carried, done, stats, level, pending)

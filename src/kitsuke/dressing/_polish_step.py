@@ -33,8 +33,6 @@ from ..metrics import layer_crossing_mm, strain
 #: residual 1 cm).
 POLISH_MEAN_STRAIN = 0.01
 POLISH_RESIDUAL_M = 0.01
-#: Layered cloth: how far the polish may leave a vertex on the wrong side of another layer, mm (the layer gap).
-POLISH_LAYER_CROSSING_MM = 2.0
 
 
 @dataclass(frozen=True)
@@ -77,7 +75,7 @@ def is_better(
         # through the right one beyond the reach where the layer planes hold it: 27 mm measured).
         crossed = layer_crossing_mm(after.positions, polished.faces, polished.face_layer, body)
         was = layer_crossing_mm(before.positions, model.faces, model.face_layer, body)
-        ok = crossed <= max(was, POLISH_LAYER_CROSSING_MM)
+        ok = crossed <= max(was, 1e3 * polished.params.layer_gap_m)
     if ok and residual_of is not None:
         rb, ra = residual_of(before.positions).max(initial=0.0), residual_of(after.positions).max(initial=0.0)
         ok = ra <= max(rb, POLISH_RESIDUAL_M)
@@ -93,8 +91,11 @@ def polish_step(
     tethers: Tethers | None = None,
     corner_data: dict[str, np.ndarray] | None = None,
     residual_of: Callable[[np.ndarray], np.ndarray] | None = None,
+    level: np.ndarray | None = None,
+    pending: np.ndarray | None = None,
 ) -> tuple[bool, RefinedPolish]:
     """Polish a copy of `state` (its pins held), open what it folded, and say whether to keep it (`is_better`).
+    level, pending : the bookkeeping of an earlier refinement of this cloth (see `polish_refined`).
     Returns (kept, the RefinedPolish: its state is the polished copy, pins extended over new vertices as free)."""
     s = settings
     trial = state.copy()
@@ -112,6 +113,8 @@ def polish_step(
         limit_sweeps=s.limit_sweeps,
         tethers=tethers,
         corner_data=corner_data,
+        level=level,
+        pending=pending,
     )
     if s.untangle_rounds and folded_faces(rp.model, rp.state).any():
         extra = {} if s.untangle_iterations is None else {"iterations": s.untangle_iterations}

@@ -22,8 +22,9 @@ class PieceOrdered:
     """A refined cloth with each piece's faces contiguous.
 
     model : the ClothModel with its faces reordered. order : (F',) int64, the refinement's face at each position.
-    parent : (F',) int64, the unrefined face each face lies in. piece_faces : (P, 2) int64 [start, stop) ranges.
-    corner_uv : (F', 3, 2) float64 metres, each corner's pattern position in its piece.
+    parent : (F',) int64, the face of the cloth given to the refinement that each face came from. piece_faces :
+    (P, 2) int64 [start, stop) ranges. corner_uv : (F', 3, 2) float64 metres, each corner's pattern position in
+    its piece. level, pending : the refinement's bookkeeping in the new order (for a later refinement).
     """
 
     model: ClothModel
@@ -31,6 +32,8 @@ class PieceOrdered:
     parent: np.ndarray
     piece_faces: np.ndarray
     corner_uv: np.ndarray
+    level: np.ndarray | None = None
+    pending: np.ndarray | None = None
 
 
 def pieces_contiguous(refined: RefinedPolish, piece_faces: np.ndarray) -> PieceOrdered:
@@ -50,6 +53,8 @@ def pieces_contiguous(refined: RefinedPolish, piece_faces: np.ndarray) -> PieceO
         parent=refined.parent_face[order],
         piece_faces=np.stack([stops - counts, stops], axis=1).astype(np.int64),
         corner_uv=np.ascontiguousarray(refined.corner_data["uv"][order]),
+        level=None if refined.level is None else refined.level[order],
+        pending=None if refined.pending is None else refined.pending[order],
     )
 
 

@@ -72,7 +72,7 @@ from ._drag_field import body_axis, drag_weights, smooth_falloff
 from ._polish_step import PolishSettings, polish_step
 from ._solve import GlobalRelax
 from .export import GarmentFile, as_garment_file
-from .wrap import DressedGarment
+from .wrap import DressedGarment, offset_as_dressed
 
 #: Metres above the contact offset that still count as touching the body, for the contact planes of the drag's
 #: global steps (collision leaves touching cloth exactly at the offset).
@@ -287,11 +287,7 @@ class DragSession:
             raise InputError("collider must be a BodyCollider")
         self.collider = collider
         f = self._file
-        cloth = self.params.cloth
-        if isinstance(garment, DressedGarment) and cloth.contact_offset_m == ClothParams().contact_offset_m:
-            # Dragged as far off the body as it was dressed (a kimono, over its under-kimonos: 3 mm; at 1 mm its
-            # mean strain after the rough drags of tests/dressing/test_drag.py rose 0.75 -> 0.94-1.04 %).
-            cloth = dataclasses.replace(cloth, contact_offset_m=garment.model.params.contact_offset_m)
+        cloth = offset_as_dressed(garment, self.params.cloth)
         try:
             self.model = ClothModel.from_corners(
                 f.faces, f.corner_uv, n_vertices=len(f.positions), params=cloth, face_layer=f.face_layer

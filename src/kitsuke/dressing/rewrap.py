@@ -51,6 +51,7 @@ from ._polyline import resample_polyline
 from ._solve import GlobalRelax
 from .export import GarmentFile, as_garment_file
 from .strokes import Strokes, strokes_on_surface
+from .wrap import offset_as_dressed
 
 #: Largest distance, metres, from a pin point to the garment vertex it snaps to (as in the drags file).
 PIN_SNAP_M = 0.05
@@ -195,7 +196,11 @@ def rewrap(
     if collider is None:
         collider = BodyCollider.from_mesh(mesh) if isinstance(body, TriMesh) else BodyCollider.from_body(body)
     model = ClothModel.from_corners(
-        g.faces, g.corner_uv, n_vertices=len(g.positions), params=p.cloth, face_layer=g.face_layer
+        g.faces,
+        g.corner_uv,
+        n_vertices=len(g.positions),
+        params=offset_as_dressed(garment, p.cloth),
+        face_layer=g.face_layer,
     )
     pinned = snap_pins(g, pins, source=src)
     if pinned.all():
@@ -280,10 +285,25 @@ def rewrap(
             loose[model.faces[folded].reshape(-1)] = True
             state.pinned = state.pinned & ~(loose & ~pinned)
             untangle(model, state, collider, rounds=p.untangle_rounds)
+
+    def residual_of(positions: np.ndarray) -> np.ndarray:
+        """(S,) metres: each pattern stroke's largest distance (on the garment) from its 3D stroke."""
+        return np.array(
+            [
+                polyline_distance(np.einsum("ij,ijk->ik", b, positions[g.faces[f]]), path).max()
+                for _, f, b, path in tracks
+            ]
+        )
+
     if p.polish_rounds:
-        # The wrap's last step, without refinement (the garment keeps its vertices); pins and held strokes held.
+        # The wrap's last step, without refinement (the garment keeps its vertices); pins and held strokes held,
+        # and not kept if it takes a stroke farther from its line.
         kept, polished = polish_step(
-            model, state, collider, PolishSettings(rounds=p.polish_rounds, untangle_rounds=p.untangle_rounds)
+            model,
+            state,
+            collider,
+            PolishSettings(rounds=p.polish_rounds, untangle_rounds=p.untangle_rounds),
+            residual_of=residual_of,
         )
         if kept:
             state = polished.state
@@ -292,9 +312,7 @@ def rewrap(
     timings["rewrap"] = time.perf_counter() - t0
 
     pos = state.positions
-    residual = np.array(
-        [polyline_distance(np.einsum("ij,ijk->ik", b, pos[g.faces[f]]), path).max() for _, f, b, path in tracks]
-    )
+    residual = residual_of(pos)
     out = dataclasses.replace(g, positions=pos.copy())
     rep = None
     if report:

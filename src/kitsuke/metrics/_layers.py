@@ -39,11 +39,13 @@ def wrong_side_mm(
     fl = np.asarray(face_layer)
     if fl.shape != (len(f),):
         raise InputError(f"face_layer must have shape ({len(f)},), got {fl.shape}")
-    vl = np.full(len(pos), -1, dtype=np.int64)  # a vertex's layer where all its faces share one
-    for k in range(3):
-        cur = vl[f[:, k]]
-        vl[f[:, k]] = np.where(cur == -1, fl, np.where(cur == fl, cur, -2))
-    q = np.flatnonzero(vl == mine)
+    # A vertex's layer where all its faces share one (the lowest and highest of its faces' layers agree).
+    lo = np.full(len(pos), np.iinfo(np.int64).max)
+    hi = np.full(len(pos), np.iinfo(np.int64).min)
+    corner_layer = np.repeat(fl.astype(np.int64), 3)
+    np.minimum.at(lo, f.reshape(-1), corner_layer)
+    np.maximum.at(hi, f.reshape(-1), corner_layer)
+    q = np.flatnonzero((lo == mine) & (hi == mine))
     theirs = f[fl == other]
     if not len(q) or not len(theirs):
         return np.zeros(len(q))
