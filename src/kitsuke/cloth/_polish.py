@@ -314,6 +314,32 @@ def polish(
     return stats
 
 
+def cap_strain(
+    model: ClothModel,
+    state: ClothState,
+    collider: BodyCollider,
+    limit: float,
+    *,
+    sweeps: int = 1500,
+    tethers: Tethers | None = None,
+) -> None:
+    """Pull every edge strained more than `limit` back to it, leaving the others alone (in place): up to `sweeps`
+    Gauss-Seidel sweeps of `restore_lengths` with that band, the body searched afresh before the first (so the
+    sweeps correct what the search's push does), collision every LIMIT_COLLIDE_EVERY sweeps, the tethers held;
+    they stop once nothing is farther than LIMIT_TOLERANCE_M beyond the band."""
+    restore_lengths(
+        model,
+        state,
+        collider,
+        sweeps=sweeps,
+        band=limit,
+        tethers=tethers,
+        collide_every=LIMIT_COLLIDE_EVERY,
+        tolerance_m=LIMIT_TOLERANCE_M,
+        search_first=True,
+    )
+
+
 @dataclass
 class RefinedPolish:
     """What `polish_refined` made: the cloth after the polish, finer where it had folded.
@@ -390,17 +416,7 @@ def polish_refined(
 
     def limit(model: ClothModel, state: ClothState, sweeps: int) -> None:
         if strain_limit is not None and sweeps:
-            restore_lengths(
-                model,
-                state,
-                collider,
-                sweeps=sweeps,
-                band=strain_limit,
-                tethers=tethers,
-                collide_every=LIMIT_COLLIDE_EVERY,
-                tolerance_m=LIMIT_TOLERANCE_M,
-                search_first=True,
-            )
+            cap_strain(model, state, collider, strain_limit, sweeps=sweeps, tethers=tethers)
 
     # Between levels the limit only needs to show where it folds the cloth; the full count ends the last one.
     between = min(limit_sweeps, LIMIT_SWEEPS_BETWEEN)

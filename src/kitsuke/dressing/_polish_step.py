@@ -23,10 +23,9 @@ from ..cloth import (
     Tethers,
     folded_faces,
     polish_refined,
-    restore_lengths,
     untangle,
 )
-from ..cloth._polish import LIMIT_COLLIDE_EVERY, LIMIT_TOLERANCE_M
+from ..cloth._polish import cap_strain
 from ..metrics import layer_crossing_mm, strain
 
 #: What the polish must not make worse than this, if it was better (issue 3's targets: mean strain 1 %, stroke
@@ -131,17 +130,7 @@ def polish_step(
             # The cloth the untangle opened lies compressed or stretched again: limit it once more, and keep that
             # only if it folds nothing.
             limited = rp.state.copy()
-            restore_lengths(
-                rp.model,
-                limited,
-                collider,
-                sweeps=s.limit_sweeps,
-                band=s.strain_limit,
-                tethers=tethers,
-                collide_every=LIMIT_COLLIDE_EVERY,
-                tolerance_m=LIMIT_TOLERANCE_M,
-                search_first=True,
-            )
+            cap_strain(rp.model, limited, collider, s.strain_limit, sweeps=s.limit_sweeps, tethers=tethers)
             if not folded_faces(rp.model, limited).any():
                 rp.state = limited
     return is_better(model, state, rp.model, rp.state, residual_of, collider), rp
