@@ -25,7 +25,7 @@ from ._collide import (
 )
 from ._lengths import LengthStats, restore_lengths
 from ._model import ClothModel, ClothParams, ClothState, Contacts, locality_order
-from ._polish import PolishStats, RefinedPolish, bending_matrix, polish, polish_refined
+from ._polish import PolishStats, RefinedPolish, bending_stencil, polish, polish_refined
 from ._relax import RelaxStats, relax
 from ._shapes import grid_sheet, grid_tube, hugging_tube, triangle_frames
 from ._subdivide import Refinement, colliding_edges, refine, sqrt3_split
@@ -53,7 +53,7 @@ __all__ = [
     "keep_layers",
     "layer_planes",
     "colliding_edges",
-    "bending_matrix",
+    "bending_stencil",
     "grid_sheet",
     "grid_tube",
     "hugging_tube",

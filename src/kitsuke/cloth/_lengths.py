@@ -110,9 +110,10 @@ def restore_lengths(
         raise InputError("tethers must be a kitsuke.cloth.Tethers or None")
     if tethers is not None and len(tethers) and tethers.tri.max() >= model.n_vertices:
         raise InputError("tethers name cloth vertices the model does not have")
-    forward = active_edge_index(model, state)
-    backward = np.ascontiguousarray(forward[::-1])
     movable = vertex_active(model, state) & ~state.pinned
+    forward = active_edge_index(model, state)
+    forward = forward[movable[model.edges[forward]].any(axis=1)]  # an edge with both ends held cannot move
+    backward = np.ascontiguousarray(forward[::-1])
     stats = LengthStats()
     pos = state.positions
     if search_first and collider is not None:

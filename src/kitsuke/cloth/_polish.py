@@ -27,15 +27,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numba
 import numpy as np
-import scipy.sparse as sp
-from scipy.optimize import minimize
 
 from ..errors import InputError
 from ._collide import BodyCollider, collide, layer_planes
+from ._lbfgs import minimise
 from ._lengths import restore_lengths
 from ._model import ClothModel, ClothState
+from ._polish_energy import bending_stencil
 from ._subdivide import refine
 from ._tethers import Tethers
 from ._untangle import folded_faces, grow_region
@@ -89,139 +88,6 @@ class PolishStats:
     folded: int = 0
 
 
-def _cotangents(rest_corners: np.ndarray) -> np.ndarray:
-    """(F, 3) cotangent of each rest triangle's angle at corner k; rest_corners (F, 3, 2) metres."""
-    out = np.empty(rest_corners.shape[:2])
-    for k in range(3):
-        a = rest_corners[:, (k + 1) % 3] - rest_corners[:, k]
-        b = rest_corners[:, (k + 2) % 3] - rest_corners[:, k]
-        cross = np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
-        out[:, k] = np.einsum("ij,ij->i", a, b) / np.maximum(cross, 1e-300)
-    return out
-
-
-def bending_matrix(model: ClothModel, weight: np.ndarray | None = None) -> sp.csr_matrix:
-    """(V, V) quadratic bending matrix Q (Bergou et al. 2006): x^T Q x (x (V, 3) metres) sums, per hinge, 3 |e|^2
-    / (A1 + A2) |k|^2 where k is the combination of the hinge's vertices a, b, c, d (`ClothModel.hinges`) with
-    weights (-(cot b1 + cot b2), -(cot a1 + cot a2), cot a1 + cot b1, cot a2 + cot b2) / |e| — the angles at a and b
-    in each of its two rest triangles. k vanishes for any flat placement of the hinge (the weights make the
-    vector from the edge to c over c's height, minus the same for d), so Q is zero on flat cloth and isometric
-    bends cost about their dihedral angle squared. weight : (H,) per-hinge factors, default 1.
-    """
-    h, hf = model.hinges, model.hinge_faces
-    if not len(h):
-        return sp.csr_matrix((model.n_vertices, model.n_vertices))
-    cots = _cotangents(model.rest_corners)
-
-    def corner(f: np.ndarray, v: np.ndarray) -> np.ndarray:
-        return np.argmax(model.faces[f] == v[:, None], axis=1)
-
-    f1, f2 = hf[:, 0], hf[:, 1]
-    a, b = h[:, 0], h[:, 1]
-    ca1, cb1 = cots[f1, corner(f1, a)], cots[f1, corner(f1, b)]
-    ca2, cb2 = cots[f2, corner(f2, a)], cots[f2, corner(f2, b)]
-    rc = model.rest_corners
-    e = np.linalg.norm(rc[f1, corner(f1, a)] - rc[f1, corner(f1, b)], axis=1)
-    w = np.stack([-(cb1 + cb2), -(ca1 + ca2), ca1 + cb1, ca2 + cb2], axis=1) / e[:, None]
-    coef = 3.0 * e**2 / (model.rest_areas[f1] + model.rest_areas[f2])
-    if weight is not None:
-        coef = coef * weight
-    vals = coef[:, None, None] * w[:, :, None] * w[:, None, :]
-    rows = np.repeat(h, 4, axis=1).reshape(-1)
-    cols = np.tile(h, (1, 4)).reshape(-1)
-    n = model.n_vertices
-    return sp.csr_matrix((vals.reshape(-1), (rows, cols)), shape=(n, n))
-
-
-@numba.njit(cache=True)
-def stretch_energy(x, edges, rest, soft, limit, limit_strain, grad):  # pragma: no cover - numba
-    """Edge stretch energy (see the module docstring) of x (V, 3); adds its gradient to grad (V, 3)."""
-    total = 0.0
-    for i in range(edges.shape[0]):
-        a, b = edges[i, 0], edges[i, 1]
-        dx = x[a, 0] - x[b, 0]
-        dy = x[a, 1] - x[b, 1]
-        dz = x[a, 2] - x[b, 2]
-        length = np.sqrt(dx * dx + dy * dy + dz * dz) + 1e-300
-        L = rest[i]
-        s = length / L - 1.0
-        total += L * soft * s * s
-        de = 2.0 * L * soft * s
-        over = abs(s) - limit_strain
-        if over > 0.0:
-            total += L * limit * over * over
-            de += 2.0 * L * limit * over * (1.0 if s > 0.0 else -1.0)
-        f = de / (L * length)
-        grad[a, 0] += f * dx
-        grad[a, 1] += f * dy
-        grad[a, 2] += f * dz
-        grad[b, 0] -= f * dx
-        grad[b, 1] -= f * dy
-        grad[b, 2] -= f * dz
-    return total
-
-
-@numba.njit(cache=True)
-def plane_energy(x, index, points, normals, offset, weight, grad):  # pragma: no cover - numba
-    """Contact energy: weight max(offset - (x_v - p) . n, 0)^2 per vertex v = index[j] with plane (points[j],
-    normals[j]); adds its gradient to grad."""
-    total = 0.0
-    for j in range(index.shape[0]):
-        v = index[j]
-        d = 0.0
-        for c in range(3):
-            d += (x[v, c] - points[j, c]) * normals[j, c]
-        depth = offset - d
-        if depth > 0.0:
-            total += weight * depth * depth
-            for c in range(3):
-                grad[v, c] -= 2.0 * weight * depth * normals[j, c]
-    return total
-
-
-@numba.njit(cache=True)
-def layer_energy(x, vertex, tri, bary, normals, gap, weight, grad):  # pragma: no cover - numba
-    """Layer order energy: weight max(gap - (x_v - q) . n, 0)^2 per layered vertex v = vertex[j] with q = sum bary[j]
-    x[tri[j]] its nearest point on the other layer's face and n = normals[j] the way it must lie from there; adds
-    its gradient (on v and on the face's corners) to grad."""
-    total = 0.0
-    for j in range(vertex.shape[0]):
-        v = vertex[j]
-        h = 0.0
-        for c in range(3):
-            q = bary[j, 0] * x[tri[j, 0], c] + bary[j, 1] * x[tri[j, 1], c] + bary[j, 2] * x[tri[j, 2], c]
-            h += (x[v, c] - q) * normals[j, c]
-        short = gap - h
-        if short > 0.0:
-            total += weight * short * short
-            f = 2.0 * weight * short
-            for c in range(3):
-                grad[v, c] -= f * normals[j, c]
-                for k in range(3):
-                    grad[tri[j, k], c] += f * bary[j, k] * normals[j, c]
-    return total
-
-
-@numba.njit(cache=True)
-def tether_energy(x, tri, bary, targets, reach, weight, grad):  # pragma: no cover - numba
-    """Tether energy: weight max(|p - q| - reach, 0)^2 per cloth point p = sum bary x[tri] with target q =
-    targets[j]; adds its gradient to grad."""
-    total = 0.0
-    r = np.zeros(3)
-    for j in range(tri.shape[0]):
-        for c in range(3):
-            r[c] = bary[j, 0] * x[tri[j, 0], c] + bary[j, 1] * x[tri[j, 1], c] + bary[j, 2] * x[tri[j, 2], c]
-            r[c] -= targets[j, c]
-        d = np.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
-        if d > reach:
-            total += weight * (d - reach) ** 2
-            f = 2.0 * weight * (d - reach) / d
-            for k in range(3):
-                for c in range(3):
-                    grad[tri[j, k], c] += f * bary[j, k] * r[c]
-    return total
-
-
 def polish(
     model: ClothModel,
     state: ClothState,
@@ -245,13 +111,25 @@ def polish(
     stats = PolishStats()
     if not rounds:
         return stats
-    edges, rest = model.edges, model.rest_lengths
     offset, layer_gap = model.params.contact_offset_m, model.params.layer_gap_m
-    hinge_weight = np.ones(len(model.hinges))
-    Q = bending_matrix(model)
     used = np.zeros(model.n_vertices, dtype=bool)
     used[model.faces[state.face_active].reshape(-1)] = True
-    free = np.flatnonzero(used & ~state.pinned)
+    moving = used & ~state.pinned
+    free = np.flatnonzero(moving)
+    # Only the terms that touch a moving vertex: the rest are constant (a local polish after a refinement moves a
+    # tenth of the garment; its energy over the whole garment made it four times slower).
+    local_edges = moving[model.edges].any(axis=1)
+    edges, rest = np.ascontiguousarray(model.edges[local_edges]), model.rest_lengths[local_edges]
+    local_hinges = moving[model.hinges].any(axis=1)
+    hinges = np.ascontiguousarray(model.hinges[local_hinges])
+    bend_w, bend_coef = bending_stencil(model)
+    bend_w, bend_coef = bend_w[local_hinges], BEND_WEIGHT * bend_coef[local_hinges]
+    hinge_weight = np.ones(len(hinges))
+    tether_tri, tether_bary, reach = np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3)), 0.0
+    if tethers is not None and len(tethers):
+        tethered = moving[tethers.tri].any(axis=1)
+        tether_tri = np.ascontiguousarray(tethers.tri[tethered], dtype=np.int64)
+        tether_bary, reach = np.ascontiguousarray(tethers.bary[tethered]), float(tethers.reach_m)
     for r in range(rounds):
         collide(model, state, collider)
         if r:
@@ -260,55 +138,30 @@ def polish(
                 near_fold = np.zeros(model.n_vertices, dtype=bool)
                 near_fold[model.faces[folded].reshape(-1)] = True
                 near_fold = grow_region(model.faces, near_fold, STIFFEN_RINGS)
-                grown = near_fold[model.hinges].any(axis=1)
+                grown = near_fold[hinges].any(axis=1)
                 hinge_weight[grown] = np.minimum(hinge_weight[grown] * STIFFEN, STIFFEN_MAX)
-                Q = bending_matrix(model, hinge_weight)
         c = state.contacts
-        near = np.flatnonzero((c.face >= 0) & (c.distance < CONTACT_REACH_M) & ~state.pinned)
+        near = np.flatnonzero((c.face >= 0) & (c.distance < CONTACT_REACH_M) & moving)
         layers = layer_planes(model, state)
         layer_tri = np.ascontiguousarray(model.faces[layers.face])
+        mine = moving[layers.vertex] | moving[layer_tri].any(axis=1)
+        layer_v, layer_tri = np.ascontiguousarray(layers.vertex[mine]), np.ascontiguousarray(layer_tri[mine])
+        layer_b, layer_n = np.ascontiguousarray(layers.bary[mine]), np.ascontiguousarray(layers.normal[mine])
         points, normals = np.ascontiguousarray(c.point[near]), np.ascontiguousarray(c.normal[near])
-        targets = tethers.nearest(state.positions) if tethers is not None and len(tethers) else None
-        start = state.positions.copy()
-
-        def energy(
-            z: np.ndarray,
-            start=start,
-            Q=Q,
-            near=near,
-            points=points,
-            normals=normals,
-            targets=targets,
-            layers=layers,
-            layer_tri=layer_tri,
-        ):
-            x = start.copy()
-            x[free] = z.reshape(-1, 3)
-            g = np.zeros_like(x)
-            total = stretch_energy(x, edges, rest, STRETCH_WEIGHT, LIMIT_WEIGHT, LIMIT_STRAIN, g)
-            qx = Q @ x
-            total += BEND_WEIGHT * float(np.einsum("ij,ij->", x, qx))
-            g += 2.0 * BEND_WEIGHT * qx
-            total += plane_energy(x, near, points, normals, offset, CONTACT_WEIGHT, g)
-            if len(layers.vertex):
-                total += layer_energy(
-                    x, layers.vertex, layer_tri, layers.bary, layers.normal, layer_gap, LAYER_WEIGHT, g
-                )
-            if targets is not None:
-                total += tether_energy(x, tethers.tri, tethers.bary, targets, tethers.reach_m, TETHER_WEIGHT, g)
-            return total, g[free].reshape(-1)
-
-        res = minimize(
-            energy,
-            state.positions[free].reshape(-1),
-            jac=True,
-            method="L-BFGS-B",
-            options={"maxiter": iterations, "maxcor": LBFGS_MEMORY},
-        )
-        state.positions[free] = res.x.reshape(-1, 3)
+        targets = np.zeros((0, 3))
+        if tethers is not None and len(tethers):
+            targets = np.ascontiguousarray(tethers.nearest(state.positions)[tethered])
+        terms = (
+            edges, rest, STRETCH_WEIGHT, LIMIT_WEIGHT, LIMIT_STRAIN,
+            hinges, bend_w, np.ascontiguousarray(bend_coef * hinge_weight),
+            near, points, normals, offset, CONTACT_WEIGHT,
+            layer_v, layer_tri, layer_b, layer_n, layer_gap, LAYER_WEIGHT,
+            tether_tri, tether_bary, targets, reach, TETHER_WEIGHT,
+        )  # fmt: skip
+        energy, done, _ = minimise(state.positions, free, iterations, LBFGS_MEMORY, terms)
+        stats.iterations += int(done)
+        stats.energy = float(energy)
         stats.rounds += 1
-        stats.iterations += int(res.nit)
-        stats.energy = float(res.fun)
     collide(model, state, collider)
     stats.folded = int(folded_faces(model, state).sum())
     return stats
@@ -439,14 +292,15 @@ def polish_refined(
         level, pending, carried = r.level, r.pending, r.corner_data
         parent = parent[r.parent_face]
         done += 1
-        # The rest of the garment has been polished: only the refined cloth and LOCAL_RINGS rings round it move.
+        # The rest of the garment has been polished and limited: only the refined cloth and LOCAL_RINGS rings round
+        # it move.
         local = np.concatenate([near, np.ones(model.n_vertices - len(near), dtype=bool)])
         local = grow_region(model.faces, local, LOCAL_RINGS)
         held = state.pinned
         state.pinned = held | ~local
         more = polish(model, state, collider, rounds=rounds, iterations=refine_iterations, tethers=tethers)
-        state.pinned = held
         limit(model, state, between)
+        state.pinned = held
         stats.rounds += more.rounds
         stats.iterations += more.iterations
         stats.energy, stats.folded = more.energy, more.folded
