@@ -287,7 +287,8 @@ def test_polish_keeps_squeezed_layers_in_order():
     state = ClothState.new(model, pos)
     polish(model, state, floor_collider(), rounds=6, iterations=60)
     x = state.positions
-    assert x[:, 2].max() > 0.006  # they buckled
+    # They buckled: nothing is left squeezed (flat, every edge would be 10 % short) and the sheets rose.
+    assert strain(x, model.edges, model.rest_lengths).max < 0.01 and x[:, 2].max() > 0.004
     import igl
 
     under = faces[layer == 1]

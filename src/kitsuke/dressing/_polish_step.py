@@ -47,7 +47,7 @@ class PolishSettings:
     refine_iterations: int = 80
     max_folds: int = 20
     strain_limit: float | None = 0.045
-    limit_sweeps: int = 1500
+    limit_sweeps: int = 1000
     untangle_rounds: int = 10
     untangle_bend: float = 0.1
     untangle_iterations: int | None = None
