@@ -116,7 +116,7 @@ def _row(tool: str, first: float, warm: float, r) -> str:
     return (
         f"| {tool} | {first:.2f} | {warm:.2f} | {r.n_vertices} "
         f"| {r.penetration_count} / {r.penetration_deepest_mm:.1f} "
-        f"| {100 * r.strain_mean:.1f} / {100 * r.strain_max:.0f} | {r.seam_gap_mm:.1f} | {r.inverted_count} |"
+        f"| {100 * r.strain_mean:.1f} / {100 * r.strain_max:.1f} | {r.seam_gap_mm:.1f} | {r.inverted_count} |"
     )
 
 

@@ -8,19 +8,21 @@ a hood gathered at the neck), and cloth pulled between two contacts stays stretc
 The energy, per round, with the body's contact planes and the stroke tethers' nearest points held fixed:
 
 - stretch: sum over edges of L (STRETCH_WEIGHT s^2 + LIMIT_WEIGHT max(|s| - LIMIT_STRAIN, 0)^2), s = l / L - 1
-  (L the rest length): a quadratic spring and, past LIMIT_STRAIN, a barrier of the same stiffness on top;
-- bending: x^T Q x with Q the quadratic bending matrix (Bergou et al. 2006, "A quadratic bending model for
-  inextensible surfaces"): per hinge, the cotangent-weighted combination of its four vertices that vanishes
-  while the hinge is flat, squared; constant, so its gradient is 2 Q x;
+  (L the rest length): a quadratic spring and, past LIMIT_STRAIN, a stiffer barrier on top;
+- bending: BEND_WEIGHT times the quadratic bending energy (Bergou et al. 2006, "A quadratic bending model for
+  inextensible surfaces"; `bending_stencil`): per hinge, the cotangent-weighted combination of its four vertices
+  that vanishes while the hinge is flat, squared;
 - contact: CONTACT_WEIGHT max(offset - (x - p) . n, 0)^2 per vertex near the body (p, n its tracked body point
   and normal, offset `ClothParams.contact_offset_m`);
 - tethers: TETHER_WEIGHT max(|x - q| - reach, 0)^2 per tethered cloth point, q its nearest polyline point;
 - layers (layered cloth): LAYER_WEIGHT max(gap - (x - q) . n, 0)^2 per vertex over or under another layer, q its
   nearest point there (moving with that face) and n the way it must lie (`layer_planes`).
 
-Between rounds the collision runs (fresh contacts, layers kept) and hinges round triangles folded over their
-neighbours get STIFFEN times their bending weight (up to STIFFEN_MAX): a crease the energy found cheap is opened
-into a rounder buckle (measured on the FreeSewing T-shirt after the wrap: 3 folded triangles without it, 0 with).
+Each round is one call of a compiled L-BFGS (`_lbfgs.minimise`) over the compiled energy (`_polish_energy`), built
+from the terms that touch a moving vertex only. Between rounds the collision runs (fresh contacts, layers kept)
+and hinges round triangles folded over their neighbours get STIFFEN times their bending weight (up to
+STIFFEN_MAX): a crease the energy found cheap is opened into a rounder buckle (measured on the FreeSewing T-shirt
+after the wrap: 3 folded triangles without it, 0 with).
 """
 
 from __future__ import annotations
