@@ -37,7 +37,7 @@ def test_demo_writes_real_files(run_cli, tmp_path):
     body = load_mesh(out / "body.glb")
     assert body.n_vertices == default_body().mesh.n_vertices
     kimono = load_pattern(out / "kimono.json")
-    assert len(kimono.pieces) == 7 and len(kimono.seams) == 23
+    assert len(kimono.pieces) == 7 and len(kimono.seams) == 21
     assert load_mesh(out / "kimono.obj").n_faces > 10_000
     assert "<svg" in (out / "kimono.svg").read_text()[:500]
     masks = {}

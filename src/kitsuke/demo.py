@@ -74,7 +74,8 @@ def run_demo(out_dir: str | Path = "out", *, size: tuple[int, int] = (800, 1000)
     write_pattern_obj(mesh, out / "kimono.obj", seams=kimono.seams)
     q = mesh_quality(mesh)
     result.files[out / "kimono.obj"] = (
-        f"meshed pattern, {len(mesh.faces)} triangles, min angle {q['min_angle_deg']:.1f} deg"
+        f"meshed pattern, {len(mesh.faces)} triangles, min angle {q['min_angle_away_deg']:.1f} deg "
+        f"({q['min_angle_deg']:.1f} at the {q['sharpest_corner_deg']:.0f} deg okumi points)"
     )
     step("mesh", t)
 

@@ -42,11 +42,11 @@ def test_kimono_and_mesh(run_cli, tmp_path):
     obj = tmp_path / "kimono.obj"
     r = run_cli("pattern", "mesh", k, "-o", obj, "--edge-length", "3")
     summary = json.loads(r.out)
-    assert r.code == 0 and summary["seams"] == 23 and summary["quality"]["min_angle_deg"] >= 25
+    assert r.code == 0 and summary["seams"] == 21 and summary["quality"]["min_angle_away_deg"] >= 25
     assert obj.read_text().count("\nf ") == summary["faces"]
     square = tmp_path / "square.json"
     assert run_cli("pattern", "kimono", "--sleeve-round", "0", "-o", square).code == 0
-    assert len(json.loads(square.read_text())["seams"]) == 21  # no rounded sleeve corners to sew
+    assert len(json.loads(square.read_text())["seams"]) == 19  # no rounded sleeve corners to sew
     r = run_cli("pattern", "texture", "-o", tmp_path / "tile.png", "--px-per-cm", "10")
     assert r.code == 0 and json.loads(r.out)["tile_cm"][0] == 3.0
 

@@ -210,6 +210,7 @@ class RefinedPolish:
     stats : the first polish's PolishStats, with the later polishes' rounds and iterations added (energy and
     folded: the last polish's). level, pending : the refinement's bookkeeping per face (`Refinement.level`,
     `.pending`), None if nothing was refined: pass them to a later `polish_refined` of the same cloth.
+    tethers : the tethers given, moved onto the refined faces (`Tethers.refined`), or None.
     """
 
     model: ClothModel
@@ -220,6 +221,7 @@ class RefinedPolish:
     stats: PolishStats
     level: np.ndarray | None = None
     pending: np.ndarray | None = None
+    tethers: Tethers | None = None
 
 
 def polish_refined(
@@ -291,9 +293,12 @@ def polish_refined(
         near[model.faces[folded].reshape(-1)] = True
         near = grow_region(model.faces, near, rings)
         select = near[model.faces].all(axis=1) & state.face_active
+        before = model
         model, state, r = refine(
             model, state, collider, select=select, level=level, pending=pending, corner_data=carried
         )
+        if tethers is not None:
+            tethers = tethers.refined(before, model, r.parent_face)
         level, pending, carried = r.level, r.pending, r.corner_data
         parent = parent[r.parent_face]
         done += 1
@@ -311,4 +316,4 @@ def polish_refined(
         stats.energy, stats.folded = more.energy, more.folded
     if limit_sweeps > between:
         limit(model, state, limit_sweeps)
-    return RefinedPolish(model, state, parent, carried, done, stats, level, pending)
+    return RefinedPolish(model, state, parent, carried, done, stats, level, pending, tethers)

@@ -51,6 +51,7 @@ class PolishSettings:
     untangle_rounds: int = 10
     untangle_bend: float = 0.1
     untangle_iterations: int | None = None
+    untangle_rings: int = 1
 
 
 def is_better(
@@ -58,11 +59,14 @@ def is_better(
     before: ClothState,
     polished: ClothModel,
     after: ClothState,
-    residual_of: Callable[[np.ndarray], np.ndarray] | None = None,
+    residual_of: Callable[[np.ndarray, RefinedPolish | None], np.ndarray] | None = None,
     body=None,
+    refined: RefinedPolish | None = None,
 ) -> bool:
     """Keep the polished cloth `after` (of `polished`, refined or `model` itself) over `before` (of `model`)? (See
-    the module docstring.) residual_of(positions) -> (S,) stroke residuals, metres, or None (no strokes). body :
+    the module docstring.) residual_of(positions, refined) -> (S,) stroke residuals, metres, of the cloth given
+    (refined None) or of `refined`, the polish that made `after` (its refinement moves the stroke samples onto new
+    faces); None: no strokes. body :
     the body (its vertices and faces) layered cloth's order is judged by (`kitsuke.metrics.wrong_side_mm`).
     (GarmentCode's shirt at 3 mm offset: the polish lowered the max 30 -> 11 % but folded three triangles, and
     opening them raised it to 34 %; its mean strain rose 0.8 -> 1.4 %.)"""
@@ -76,7 +80,8 @@ def is_better(
         was = layer_crossing_mm(before.positions, model.faces, model.face_layer, body)
         ok = crossed <= max(was, 1e3 * polished.params.layer_gap_m)
     if ok and residual_of is not None:
-        rb, ra = residual_of(before.positions).max(initial=0.0), residual_of(after.positions).max(initial=0.0)
+        rb = residual_of(before.positions, None).max(initial=0.0)
+        ra = residual_of(after.positions, refined).max(initial=0.0)
         ok = ra <= max(rb, POLISH_RESIDUAL_M)
     return bool(ok)
 
@@ -89,7 +94,7 @@ def polish_step(
     *,
     tethers: Tethers | None = None,
     corner_data: dict[str, np.ndarray] | None = None,
-    residual_of: Callable[[np.ndarray], np.ndarray] | None = None,
+    residual_of: Callable[[np.ndarray, RefinedPolish | None], np.ndarray] | None = None,
     level: np.ndarray | None = None,
     pending: np.ndarray | None = None,
 ) -> tuple[bool, RefinedPolish]:
@@ -121,16 +126,17 @@ def polish_step(
             rp.model,
             rp.state,
             collider,
+            rings=s.untangle_rings,
             rounds=s.untangle_rounds,
             bend_stiffness=s.untangle_bend,
-            tethers=tethers,
+            tethers=rp.tethers,
             **extra,
         )
         if s.strain_limit is not None and s.limit_sweeps:
             # The cloth the untangle opened lies compressed or stretched again: limit it once more, and keep that
             # only if it folds nothing.
             limited = rp.state.copy()
-            cap_strain(rp.model, limited, collider, s.strain_limit, sweeps=s.limit_sweeps, tethers=tethers)
+            cap_strain(rp.model, limited, collider, s.strain_limit, sweeps=s.limit_sweeps, tethers=rp.tethers)
             if not folded_faces(rp.model, limited).any():
                 rp.state = limited
-    return is_better(model, state, rp.model, rp.state, residual_of, collider), rp
+    return is_better(model, state, rp.model, rp.state, residual_of, collider, rp), rp

@@ -25,10 +25,6 @@ KIMONO_HANG = 2.0
 #: about a millimetre, so its contact offset is 3 mm where a garment worn on the skin has ClothParams' 1 mm. (Also
 #: measured: at 1 mm the polish pressed the crossed fronts into each other, 157 triangles folded.)
 KIMONO_OFFSET_M = 0.003
-#: WrapParams.polish_passes, polish_limit_sweeps and polish_refine_levels for a kimono (see kimono_params).
-KIMONO_POLISH_PASSES = 1
-KIMONO_LIMIT_SWEEPS = 400
-KIMONO_REFINE_LEVELS = 0
 
 
 def is_kimono(pattern) -> bool:
@@ -39,26 +35,13 @@ def is_kimono(pattern) -> bool:
 
 def kimono_params(body, params: WrapParams | None = None, *, hang: float | None = None) -> WrapParams:
     """`params` (default WrapParams()) made right for a kimono: sleeves that hang, the cloth KIMONO_OFFSET_M off
-    the body (where `params` keeps ClothParams' default offset), a shorter polish (where `params` keeps the
-    default) and, on a rigged body, the waist held in the obi
+    the body (where `params` keeps ClothParams' default offset) and, on a rigged body, the waist held in the obi
     band (where `params` holds no band). `hang` sets WrapParams.hang; None keeps a hang that `params` sets and
     gives KIMONO_HANG where it sets none (0)."""
     p = params or WrapParams()
     changes: dict = {}
     if p.cloth.contact_offset_m == ClothParams().contact_offset_m:
         changes["cloth"] = dataclasses.replace(p.cloth, contact_offset_m=KIMONO_OFFSET_M)
-    # The kimono misses the 5 % max strain either way (where the collars cross and at the neck point; polished
-    # with refinement 16-43 % over nanometre changes of the body, but then with the left front pushed through the
-    # right one, so the polish is not kept): one pass, no refinement and the shorter strain limit keep its wrap
-    # near 6 s instead of 14-50 s.
-    defaults = WrapParams()
-    for name, value in (
-        ("polish_passes", KIMONO_POLISH_PASSES),
-        ("polish_limit_sweeps", KIMONO_LIMIT_SWEEPS),
-        ("polish_refine_levels", KIMONO_REFINE_LEVELS),
-    ):
-        if getattr(p, name) == getattr(defaults, name):
-            changes[name] = value
     if hang is not None or p.hang == 0.0:
         changes["hang"] = KIMONO_HANG if hang is None else hang
     if p.hold_band_m is None and getattr(body, "rig", None) is not None:

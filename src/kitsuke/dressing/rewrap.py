@@ -286,8 +286,9 @@ def rewrap(
             state.pinned = state.pinned & ~(loose & ~pinned)
             untangle(model, state, collider, rounds=p.untangle_rounds)
 
-    def residual_of(positions: np.ndarray) -> np.ndarray:
-        """(S,) metres: each pattern stroke's largest distance (on the garment) from its 3D stroke."""
+    def residual_of(positions: np.ndarray, _refined=None) -> np.ndarray:
+        """(S,) metres: each pattern stroke's largest distance (on the garment) from its 3D stroke (the polish here
+        does not refine, so the garment's faces hold the samples)."""
         return np.array(
             [
                 polyline_distance(np.einsum("ij,ijk->ik", b, positions[g.faces[f]]), path).max()

@@ -12,8 +12,12 @@ A kimono is cut from one bolt into straight rectangles. Seven pieces are made he
   (繰越); then the back seam down to the back hem. Along the outer edge, from the front hem: side seam, underarm
   opening (身八つ口, `underarm_opening`), sleeve attachment (袖付け, `sleeve_attachment`) up to the shoulder fold,
   then the same three mirrored down the back.
-- **okumi_right, okumi_left** (front overlap panels 衽): `okumi_width` x (length - okumi_drop), sewn along the
-  migoro's front centre edge. The collar runs down their front edge to `collar_end` above the hem (衿先).
+- **okumi_right, okumi_left** (front overlap panels 衽): `okumi_width` wide, sewn along the migoro's front centre
+  edge up to `okumi_drop` below the shoulder, where the okumi comes to a point (剣先); from there its top is cut on
+  the slant down to its front edge at `collar_end` above the hem (衿先). The collar is sewn along that slant (衽の
+  衿付け), which continues the body panel's neck diagonal almost straight (8° on the standard size): cut square,
+  with the collar along the top and down the front edge, the straight collar had to turn a right angle at the
+  okumi's corner, and on the body the under collar crumpled there, compressed by up to 47 %.
 - **sode_right, sode_left** (sleeves 袖): **one piece each**, `sleeve_width` wide and 2 x `sleeve_depth` long,
   folded at the top (the sleeve crease 袖山 at y = sleeve_depth, in line with the shoulder fold), as it is cut.
   Seams: the sleeve attachment (front and back halves to the migoro), the bottom (袖底: the two short ends), the
@@ -21,7 +25,7 @@ A kimono is cut from one bolt into straight rectangles. Seven pieces are made he
   the rounded corner (袖の丸み, `sleeve_round`, a quarter circle: 2 cm on a standard or formal kimono, up to ~12 cm
   on everyday ones). The body side below the attachment stays open (振り).
 - **eri** (collar 衿): a strip `collar_width` wide whose one long edge is sewn, left collar end to right collar end,
-  along the okumi front edge, okumi top, neck diagonal and back neck of each side; its length is their sum.
+  along the okumi's slanted top, the neck diagonal and the back neck of each side; its length is their sum.
 The over-collar (tomoeri 共衿) is left out: it is a second layer on the front part of the collar and adds no shape.
 
 The fronts: the wearer's left front goes over the right (left over right), so in the placement hint the left okumi
@@ -324,16 +328,18 @@ def make_kimono(
         hang(0.0, L),
     )
     # Okumi: the right one lies over the left body panel's front (under the left okumi), 1 cm behind it.
+    # The centre edge (sewn to the migoro) runs up to the point (剣先) at H; the front edge up to the collar end at E;
+    # the collar is sewn along the slant between them.
     add(
         "okumi_right",
-        [(0, 0), (O, 0), (O, E), (O, H), (0, H)],
-        ["hem", "front_free", "front_collar", "top", "centre"],
+        [(0, 0), (O, 0), (O, E), (0, H)],
+        ["hem", "front_free", "front_collar", "centre"],
         Placement([0.0, shoulder_y + lift - L / 100.0, zf + 0.005], [0, 0, 0]),
     )
     add(
         "okumi_left",
-        [(0, 0), (O, 0), (O, H), (0, H), (0, E)],
-        ["hem", "centre", "top", "front_collar", "front_free"],
+        [(0, 0), (O, 0), (O, H), (0, E)],
+        ["hem", "centre", "front_collar", "front_free"],
         Placement([-O / 100.0, shoulder_y + lift - L / 100.0, zf + 0.015], [0, 0, 0]),
     )
     # Sleeves: one folded piece each, crease at y = D on the shoulder fold; body side towards the body panel. The
@@ -377,16 +383,14 @@ def make_kimono(
         rounds = {"front_round": arc, "back_round": arc} if R > 0 else {}
         add(f"sode_{side}", [p for p, _ in outline], [nm for _, nm in outline], hang(x0 / 100.0, D), rounds)
     # Collar: its bottom edge (y = 0), left collar end (x = 0) to right collar end, is sewn segment by segment.
-    diag, bneck, upper = math.hypot(n, sd), math.hypot(n, k), H - E
+    diag, bneck, slant = math.hypot(n, sd), math.hypot(n, k), math.hypot(O, H - E)
     segs = [
-        ("left_okumi_front", upper),
-        ("left_okumi_top", O),
+        ("left_okumi", slant),
         ("left_front_neck", diag),
         ("left_back_neck", bneck),
         ("right_back_neck", bneck),
         ("right_front_neck", diag),
-        ("right_okumi_top", O),
-        ("right_okumi_front", upper),
+        ("right_okumi", slant),
     ]
     xs = np.concatenate([[0.0], np.cumsum([v for _, v in segs])])
     Lc, e = float(xs[-1]), s.collar_width
@@ -426,15 +430,14 @@ def make_kimono(
             seams.append(seam(sode, "front_round", sode, "back_round"))
     for side in ("left", "right"):
         seams += [
-            seam("eri", f"{side}_okumi_front", f"okumi_{side}", "front_collar"),
-            seam("eri", f"{side}_okumi_top", f"okumi_{side}", "top"),
+            seam("eri", f"{side}_okumi", f"okumi_{side}", "front_collar"),
             seam("eri", f"{side}_front_neck", f"migoro_{side}", "front_neck"),
             seam("eri", f"{side}_back_neck", f"migoro_{side}", "back_neck"),
         ]
     # Left over right (SPEC §5.4): the left okumi, the left body panel's front and the collar down the left okumi
     # lie over their right counterparts where they cross on the body.
     front = (0.0, 0.0, K, L)
-    crossing = O + upper  # the collar along an okumi's front edge and top
+    crossing = slant  # the collar along an okumi's slanted top
     layers = [
         LayerRegion("okumi_left", 2),
         LayerRegion("migoro_left", 2, front),
