@@ -176,3 +176,41 @@ def test_one_face_with_corner_data_splits_without_flips():
     r = sqrt3_split(f, uv[f], select, corner_data={"uv": uv[f] * 2.0})
     assert r.flipped == 0 and len(r.faces) == len(f) + 2
     np.testing.assert_allclose(r.corner_data["uv"], r.rest_corners * 2.0)
+
+
+def test_tethers_follow_a_refinement_to_the_faces_holding_their_points():
+    """Tethers on a sheet bent in z, refined twice round its middle (with edge flips): every point keeps its place
+    in the rest shape, now on a face of the refined cloth, and so its x and y on the cloth (linear over the rest
+    plane, whatever the triangles); z moves by what the flips change of the bent surface (under 0.1 mm here); a
+    tether on a face the cloth does not have is refused."""
+    from kitsuke.cloth import Tethers
+
+    model, rest = flat_sheet(7, 6, 0.02)
+    x = rest.copy()
+    x[:, 2] = 0.3 * (x[:, 0] - 0.06) ** 2  # bent: a point between old corners lies off a refined surface later
+    rng = np.random.default_rng(7)
+    faces = rng.choice(model.n_faces, 40)
+    bary = rng.dirichlet(np.ones(3), 40)
+    line = np.array([[0.0, 0.05, 0.0], [0.12, 0.05, 0.0]])
+    tethers = Tethers.from_polylines([(faces, bary, line)], model.faces, 0.01)
+    m, s = model, ClothState.new(model, x)
+    level = pending = None
+    for _ in range(2):
+        select = np.abs(m.rest_corners[..., 0].mean(axis=1) - 0.06) < 0.03
+        before = m
+        m, s, r = refine(m, s, select=select, level=level, pending=pending)
+        level, pending = r.level, r.pending
+        assert r.flipped > 0
+        tethers = tethers.refined(before, m, r.parent_face)
+    key = {tuple(sorted(f)): i for i, f in enumerate(m.faces)}
+    face = np.array([key[tuple(sorted(t))] for t in tethers.tri])  # every tether on a face of the refined cloth
+    rest_point = np.einsum("nk,nkc->nc", tethers.bary, m.rest_corners[face])
+    was = np.einsum("nk,nkc->nc", bary, model.rest_corners[faces])
+    np.testing.assert_allclose(rest_point, was, atol=1e-12)
+    now = np.einsum("nk,nkc->nc", tethers.bary, s.positions[tethers.tri])
+    np.testing.assert_allclose(now[:, :2], was, atol=1e-12)
+    assert np.abs(now[:, 2] - 0.3 * (was[:, 0] - 0.06) ** 2).max() < 1e-4
+    assert (tethers.bary >= 0).all() and np.allclose(tethers.bary.sum(axis=1), 1.0)
+    wrong = Tethers.from_polylines([(faces[:1], bary[:1], line)], model.faces[:, [0, 2, 1]] + 1, 0.01)
+    with pytest.raises(InputError, match="triangle the cloth does not have"):
+        wrong.refined(model, m, r.parent_face)
