@@ -5,7 +5,7 @@ measured quality (SPEC §6) with a small margin, so a change that makes a shippe
 
 Issue 3's targets: penetration (none deeper than 2 mm), seam gap (≤ 3 mm), no inverted triangle, mean strain
 (≤ 1 %), stroke residual (≤ 10 mm, since the wrap tethers its strokes) and max strain (≤ 5 %) are met and asserted
-for every case here (the kimono's, which misses the max strain, are in test_wrap.py)."""
+for every case here, and for the kimono in test_wrap.py."""
 
 from __future__ import annotations
 
