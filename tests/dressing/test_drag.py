@@ -3,9 +3,10 @@ every step; bad input.
 
 Two garments: a skirt (a tube sewn from a flat rectangle, hung round the hips with a little ease: exactly at rest,
 so every strain it shows comes from the drag) and the kimono exactly as `kitsuke demo` dresses it
-(`dress_default_kimono`, 1.5 cm triangles). The wrap's kimono meets every quality target of issue 3 but the max
-strain (41 % at its neck, a cone point of the pattern), so after each drag on it those targets are held and the max
-is not.
+(`dress_default_kimono`, 1.5 cm triangles), which meets every quality target of issue 3 (max strain 4.8 %). After
+the lift, the turn, the rolled-up sleeve and rough drags every target still holds (a release refines where the drag
+bunched the cloth, so the garment may come back with more vertices: old ones keep their indices); after the front
+is lifted 6 cm with the back pinned, all but the max strain (see that test).
 """
 
 from __future__ import annotations
@@ -74,9 +75,8 @@ def assert_quality_kept(before, after) -> None:
 
 
 def assert_kimono_targets_kept(before, after) -> None:
-    """The wrap's quality targets that the dressed kimono meets (issue 3; measured after each drag here: mean
-    strain 0.63-0.86 %, nothing inside the body, nothing folded): kept after a drag step. Its max strain (41 % at
-    its neck before any drag) is not a target it meets, so it is not held."""
+    """The wrap's quality targets but the max strain (issue 3): kept after a drag step that the max strain target
+    cannot survive (the pinned drag below)."""
     assert before.strain_mean <= 0.01 and before.inverted_count == 0 and before.penetration_count == 0
     assert after.penetration_count == 0 and after.penetration_deepest_mm <= 2.0
     assert after.inverted_count == 0
@@ -100,7 +100,7 @@ def test_lift_the_skirt_moves_every_vertex_5_cm_up_along_the_body(body, skirt, c
     s.grab(vertex=g)
     stats = s.move_by([0.0, 0.05, 0.0])
     s.release()
-    move = s.positions - x0
+    move = s.positions[: len(x0)] - x0
     dist = np.linalg.norm(move, axis=1)
     assert stats.updates == 5 and abs(stats.grab_moved_m - 0.05) < 0.003  # chords of the 5 cm path on the body
     assert np.abs(dist - 0.05).max() <= 0.015
@@ -109,19 +109,19 @@ def test_lift_the_skirt_moves_every_vertex_5_cm_up_along_the_body(body, skirt, c
 
 
 def test_lift_the_kimono(body, kimono, collider):
-    """The kimono rises with its front: the median vertex moves 5 cm, nine in ten within 5 +- 1.5 cm (the rest
-    are cloth the relaxation also straightens: the wrap left it strained), and its quality is no worse."""
+    """The kimono rises with its front: the median vertex moves 5 cm, nine in ten within 5 +- 1.5 cm, and every
+    quality target still holds (measured 2026-11-25: max strain 4.77 -> 4.50 %, mean 0.33 -> 0.21 %)."""
     s = DragSession(body, kimono, collider=collider)
     before = s.report()
     x0 = s.positions.copy()
     s.grab(vertex=front_of(x0, 1.1))
     s.move_by([0.0, 0.05, 0.0])
     s.release()
-    dist = np.linalg.norm(s.positions - x0, axis=1)
+    dist = np.linalg.norm(s.positions[: len(x0)] - x0, axis=1)
     assert abs(np.median(dist) - 0.05) < 0.01
     assert np.mean(np.abs(dist - 0.05) <= 0.015) >= 0.9
-    assert np.median(s.positions[:, 1] - x0[:, 1]) > 0.04
-    assert_kimono_targets_kept(before, s.report())
+    assert np.median(s.positions[: len(x0), 1] - x0[:, 1]) > 0.04
+    assert_quality_kept(before, s.report())
 
 
 # -- (b) turn -----------------------------------------------------------------------------------------------------
@@ -142,12 +142,12 @@ def test_turn_the_skirt_30_degrees_around_the_waist(body, skirt, collider):
         s.move_to([cx + np.cos(a) * r[0] + np.sin(a) * r[2], x0[g, 1], cz - np.sin(a) * r[0] + np.cos(a) * r[2]])
     s.release()
     angle0 = np.arctan2(x0[:, 0] - cx, x0[:, 2] - cz)
-    angle1 = np.arctan2(s.positions[:, 0] - cx, s.positions[:, 2] - cz)
+    angle1 = np.arctan2(s.positions[: len(x0), 0] - cx, s.positions[: len(x0), 2] - cz)
     turn = np.degrees((angle1 - angle0 + np.pi) % (2 * np.pi) - np.pi)
     assert 15 <= turn.min() and turn.max() <= 45
     assert 20 <= np.median(turn) <= 32
     assert abs(turn[g] - 30) < 1.0
-    assert np.abs(s.positions[:, 1] - x0[:, 1]).max() < 0.015  # a turn, not a lift
+    assert np.abs(s.positions[: len(x0), 1] - x0[:, 1]).max() < 0.015  # a turn, not a lift
     after = s.report()
     assert after.strain_max <= 0.05
     assert_quality_kept(before, after)
@@ -157,7 +157,9 @@ def test_turn_the_skirt_30_degrees_around_the_waist(body, skirt, collider):
 def test_pins_down_the_back_stop_a_drag_of_the_front(body, kimono, collider):
     """A row of pins down the kimono's back seam (and the back of its collar): dragging the front up leaves the
     pinned vertices exactly where they were, does not reach the half beyond the pins at all (< 5 mm: not a
-    micrometre), and moves the near half."""
+    micrometre), and moves the near half. The targets but the max strain hold: the back half and the grabbed
+    point are held still and the front is 6 cm higher, and the cloth next to the grabbed point stays stretched
+    (measured 2026-11-25: 8.2 %; 24-35 % at the underarms, compressed, before the release refined)."""
     s = DragSession(body, kimono, collider=collider)
     before = s.report()
     x0 = s.positions.copy()
@@ -170,8 +172,8 @@ def test_pins_down_the_back_stop_a_drag_of_the_front(body, kimono, collider):
     for _ in range(3):
         s.move_by([0.0, 0.02, 0.0])
     s.release()
-    move = np.linalg.norm(s.positions - x0, axis=1)
-    beyond = grab.held & ~s.pinned
+    move = np.linalg.norm(s.positions[: len(x0)] - x0, axis=1)
+    beyond = grab.held & ~s.pinned[: len(x0)]
     assert (s.positions[pins] == x0[pins]).all()
     assert beyond.sum() > 0.3 * s.n_vertices and move[beyond].max() < 0.005
     assert move[grab.vertex] > 0.05
@@ -194,7 +196,7 @@ def test_a_pin_attenuates_the_drag_without_a_kink(body, skirt, collider):
     grab = s.grab(vertex=front_of(x0, 0.9))
     s.move_by([0.0, 0.03, 0.0])
     s.release()
-    move = np.linalg.norm(s.positions - x0, axis=1)
+    move = np.linalg.norm(s.positions[: len(x0)] - x0, axis=1)
     assert move[back] == 0.0 and move[grab.vertex] > 0.025
     around = 96  # the skirt's vertices per round: vertex j * around + i
     row, col = divmod(back, around)
@@ -205,12 +207,10 @@ def test_a_pin_attenuates_the_drag_without_a_kink(body, skirt, collider):
 
 
 # -- (d) roll up a sleeve -----------------------------------------------------------------------------------------
-def test_roll_up_a_kimono_sleeve(body, kimono, collider):
-    """Pins round the upper arm of the left sleeve (a band across it, 7-10.5 cm from the shoulder seam), the cuff
-    dragged 10 cm up the forearm towards the elbow: the cuff goes, the shoulder stays."""
-    s = DragSession(body, kimono, collider=collider)
-    before = s.report()
-    x0 = s.positions.copy()
+def roll_up_left_sleeve(s: DragSession, body, kimono):
+    """Pin a band round the kimono's left upper arm (7-10.5 cm from the shoulder seam, across the sleeve), drag the
+    top of the hand opening 10 cm up the forearm towards the elbow, let go. Returns the sleeve's pattern positions
+    (V, 2) cm (NaN off the sleeve), its vertices, the band and the cuff vertex."""
     k = kimono.piece_names.index("sode_left")
     fa, fb = kimono.piece_faces[k]
     uv = np.full((s.n_vertices, 2), np.nan)
@@ -220,27 +220,63 @@ def test_roll_up_a_kimono_sleeve(body, kimono, collider):
     s.pin(vertices=band)
     cuff = int(sleeve[np.argmin(np.hypot(uv[sleeve, 0] - 32, uv[sleeve, 1] - 49))])  # top of the hand opening
     j = body.rig.joints
-    shoulder, elbow, wrist = j[INDEX["l_shoulder"]], j[INDEX["l_elbow"]], j[INDEX["l_wrist"]]
+    elbow, wrist = j[INDEX["l_elbow"]], j[INDEX["l_wrist"]]
     s.grab(vertex=cuff)
     s.move_to(elbow + 0.35 * (wrist - elbow))
     s.release()
-    move = s.positions - x0
+    return uv, sleeve, band, cuff
+
+
+def test_roll_up_a_kimono_sleeve(body, kimono, collider):
+    """Pins round the upper arm of the left sleeve (a band across it, 7-10.5 cm from the shoulder seam), the cuff
+    dragged 10 cm up the forearm towards the elbow: the cuff goes, the shoulder stays, and every quality target
+    still holds: the release refines the sleeve where it bunched so that it buckles (measured 2026-11-25: max
+    strain 4.77 %; 35 % when the release kept the 1.5 cm triangles)."""
+    s = DragSession(body, kimono, collider=collider)
+    before = s.report()
+    x0 = s.positions.copy()
+    uv, sleeve, band, cuff = roll_up_left_sleeve(s, body, kimono)
+    j = body.rig.joints
+    shoulder, elbow, wrist = j[INDEX["l_shoulder"]], j[INDEX["l_elbow"]], j[INDEX["l_wrist"]]
+    move = s.positions[: len(x0)] - x0
     forearm = (wrist - elbow) / np.linalg.norm(wrist - elbow)
     assert move[cuff] @ forearm < -0.08  # the cuff went up the forearm by 8 cm or more
     assert (move[band] == 0).all()
     near_shoulder = np.linalg.norm(x0 - shoulder, axis=1) < 0.1
     assert near_shoulder.sum() > 20 and np.abs(move[near_shoulder]).max() == 0.0
     assert np.median(move[sleeve[uv[sleeve, 0] > 25]] @ forearm) < -0.005  # the cuff's end of the sleeve bunches up
-    assert_kimono_targets_kept(before, s.report())
+    assert_quality_kept(before, s.report())
+    # The release refined the bunched sleeve: more vertices (the old keep their indices and their pins), each piece's
+    # faces still contiguous, and the garment written and read back as it is.
+    assert s.n_vertices > len(x0) and s.pinned[band].all() and not s.pinned[len(x0) :].any()
+    out = s.garment()
+    assert len(out.faces) == s.model.n_faces and out.piece_faces[-1, 1] == len(out.faces)
+    assert (out.piece_faces[1:, 0] == out.piece_faces[:-1, 1]).all()
+    np.testing.assert_array_equal(out.corner_uv, s.model.rest_corners)  # the pattern shape of every new face
+    assert np.isfinite(out.corner_uv).all() and out.piece_names == kimono.piece_names
+
+
+def test_restore_undoes_a_refining_release(body, kimono, collider):
+    """A drags file found bad after a release that refined the garment puts it back as it was: the same vertices
+    (count and positions), faces and pins."""
+    s = DragSession(body, kimono, collider=collider)
+    x0 = s.positions.copy()
+    snap = s.snapshot()
+    roll_up_left_sleeve(s, body, kimono)
+    assert s.n_vertices > len(x0)  # refined
+    s.restore(snap)
+    assert s.n_vertices == len(x0) and np.array_equal(s.positions, x0)
+    assert np.array_equal(s.model.faces, kimono.faces) and not s.pinned.any()
+    assert s.report().strain_max == pytest.approx(kimono.report.strain_max, abs=1e-6)
 
 
 # -- rough drags ---------------------------------------------------------------------------------------------------
 def test_rough_drags_up_and_down_do_not_tear_the_coarse_kimono(body, collider):
     """The kimono at 2.5 cm (as benchmarks/bench_drag.py drags it) lifted 10 cm by its front and put back, three
     times, in 1 cm updates: its hem round the shins does not tear (206 % max strain, 2.8 % mean, when collision
-    only followed the global relaxation and fought it), and the wrap's targets it met still hold. Measured
-    2026-11-25 (benchmarks/bench_drag.py): dressed 0.55 % / 37 %, after 0.49 % / 13 % mean / max strain (dragged
-    at the 3 mm it was dressed with; at 1 mm 0.94 % / 22 %)."""
+    only followed the global relaxation and fought it), and every quality target still holds. Measured
+    2026-11-25: dressed 0.30 % / 4.53 %, after 0.23 % / 4.50 % mean / max strain (before the okumi's slanted top
+    and the shoulder strokes off the neck point: dressed 0.55 % / 37 %, after 0.49 % / 13 %)."""
     from kitsuke.dressing import WrapParams
     from kitsuke.dressing.kimono import dress_default_kimono
 
@@ -253,7 +289,7 @@ def test_rough_drags_up_and_down_do_not_tear_the_coarse_kimono(body, collider):
         s.move_by([0.0, -0.1, 0.0])
     s.release()
     after = s.report()
-    assert_kimono_targets_kept(before, after)
+    assert_quality_kept(before, after)
     assert after.strain_max < before.strain_max + 0.1  # torn: 206 %
 
 
