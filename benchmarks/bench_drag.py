@@ -57,7 +57,7 @@ def main() -> None:
         garment = wrap(body, pattern, load_packaged_strokes("tshirt_default"), params=params, collider=collider)
     r0 = garment.report
     print(
-        f"dressed: strain mean {100 * r0.strain_mean:.2f} % max {100 * r0.strain_max:.0f} %, "
+        f"dressed: strain mean {100 * r0.strain_mean:.2f} % max {100 * r0.strain_max:.2f} %, "
         f"inverted {r0.inverted_count}, penetration {r0.penetration_count}"
     )
     print(
@@ -93,7 +93,7 @@ def main() -> None:
     r = session.report()
     print(
         f"quality after {2 * args.updates} updates: penetration {r.penetration_count}, strain mean "
-        f"{100 * r.strain_mean:.2f} % max {100 * r.strain_max:.0f} %, inverted {r.inverted_count}"
+        f"{100 * r.strain_mean:.2f} % max {100 * r.strain_max:.2f} %, inverted {r.inverted_count}"
     )
 
 
