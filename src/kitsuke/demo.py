@@ -102,7 +102,7 @@ def run_demo(out_dir: str | Path = "out", *, size: tuple[int, int] = (800, 1000)
         result.files[write_garment_obj(dressed, out / "dressed.obj")] = "dressed kimono, vt = pattern metres"
         verdict = "all quality targets met" if rep.ok else "targets missed: " + ", ".join(rep.failures())
         result.files[write_garment_report(dressed, out / "dressed_report.json")] = (
-            f"quality: strain mean {100 * rep.strain_mean:.1f} % max {100 * rep.strain_max:.0f} %, "
+            f"quality: strain mean {100 * rep.strain_mean:.1f} % max {100 * rep.strain_max:.1f} %, "
             f"deepest {rep.penetration_deepest_mm:.1f} mm inside, seam gap {rep.seam_gap_mm:.1f} mm; {verdict}"
         )
         shown = garment_glb_mesh(dressed, tile_m=tile[0] / 100, texture=texture)
