@@ -214,3 +214,40 @@ def test_tethers_follow_a_refinement_to_the_faces_holding_their_points():
     wrong = Tethers.from_polylines([(faces[:1], bary[:1], line)], model.faces[:, [0, 2, 1]] + 1, 0.01)
     with pytest.raises(InputError, match="triangle the cloth does not have"):
         wrong.refined(model, m, r.parent_face)
+
+
+def test_refined_tethers_stay_in_their_piece_across_a_seam():
+    """Two pieces sewn along one edge, each cut in its own pattern frame, the second's frame shifted so that its
+    faces beside the seam cover the same rest square as the first's: a point of the first piece next to the seam
+    also lies "inside" faces of the second in rest coordinates. Refined round the seam, every tether stays on a
+    face of its own piece, at its own rest point."""
+    from kitsuke.cloth import ClothParams, Tethers, grid_sheet
+
+    uv, f = grid_sheet(5, 5, 0.02)
+    n = len(uv)
+    # The second piece's column i = 0 is the first piece's column i = 4 (the seam), shared vertices.
+    second = np.arange(n) + n
+    second[uv[:, 0] == 0] = np.flatnonzero(uv[:, 0] == 0.08)
+    faces = np.concatenate([f, second[f]])
+    corners = np.concatenate([uv[f], uv[f] + [0.06, 0.0]])  # beside the seam, both pieces at rest x 0.06-0.08
+    used = np.unique(faces)
+    remap = np.full(2 * n, -1)
+    remap[used] = np.arange(len(used))
+    faces = remap[faces]
+    model = ClothModel.from_corners(faces, corners, n_vertices=len(used), params=ClothParams())
+    x = np.zeros((len(used), 3))
+    x[remap[:n], :2] = uv
+    x[remap[second], 0] = 0.08 + uv[:, 0]  # the second piece continues the first in 3D
+    x[remap[second], 1] = uv[:, 1]
+    near_seam = np.flatnonzero(uv[f].mean(axis=1)[:, 0] > 0.06)  # faces of the first piece beside the seam
+    bary = np.full((len(near_seam), 3), 1 / 3)
+    tethers = Tethers.from_polylines([(near_seam, bary, np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0]]))], faces, 0.01)
+    state = ClothState.new(model, x)
+    refined, _, r = refine(model, state, select=np.ones(model.n_faces, dtype=bool))
+    moved = tethers.refined(model, refined, r.parent_face)
+    key = {tuple(sorted(t)): i for i, t in enumerate(refined.faces)}
+    face = np.array([key[tuple(sorted(t))] for t in moved.tri])
+    assert (r.parent_face[face] < len(f)).all()  # the first piece's faces
+    np.testing.assert_allclose(
+        np.einsum("nk,nkc->nc", moved.bary, refined.rest_corners[face]), uv[f[near_seam]].mean(axis=1), atol=1e-12
+    )

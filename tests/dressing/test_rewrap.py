@@ -97,6 +97,8 @@ def test_rewrap_bad_input(body, dressed):
         RewrapParams(length_sweeps=-1)
     with pytest.raises(InputError, match="polish_rounds"):
         RewrapParams(polish_rounds=-1)
+    with pytest.raises(InputError, match="untangle_iterations"):
+        RewrapParams(untangle_iterations=0)
 
 
 def test_cli_rewrap_writes_obj_and_report_and_refuses_bad_pins(run_cli, tmp_path, body, dressed):

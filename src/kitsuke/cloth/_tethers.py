@@ -93,10 +93,21 @@ class Tethers:
         old = _face_of(before.faces, self.tri)
         point = np.einsum("nk,nkc->nc", self.bary, before.rest_corners[old])  # (n, 2) metres, rest shape
         # Candidates: the faces that came from the old face or from one across its edges (an edge flip makes a
-        # face lying partly in the face across the edge).
+        # face lying partly in the face across the edge) in the same rest frame: never across a seam, where no
+        # edge flips and the rest shapes of the two sides are two pieces' frames.
         order = np.argsort(parent_face, kind="stable")
         start = np.searchsorted(parent_face[order], np.arange(before.n_faces + 1))
         around = np.concatenate([old[:, None], before.face_adjacency[old]], axis=1)  # (n, 4), -1 on a border
+        for k in range(3):
+            g = around[:, 1 + k]
+            a, b = before.faces[old, k], before.faces[old, (k + 1) % 3]
+            rest_g = before.rest_corners[np.maximum(g, 0)]
+            at_a = rest_g[np.arange(len(old)), np.argmax(before.faces[np.maximum(g, 0)] == a[:, None], axis=1)]
+            at_b = rest_g[np.arange(len(old)), np.argmax(before.faces[np.maximum(g, 0)] == b[:, None], axis=1)]
+            same = np.isclose(at_a, before.rest_corners[old, k]).all(axis=1) & np.isclose(
+                at_b, before.rest_corners[old, (k + 1) % 3]
+            ).all(axis=1)
+            around[~same, 1 + k] = -1
         counts = np.where(around >= 0, start[np.maximum(around, 0) + 1] - start[np.maximum(around, 0)], 0)
         width = int(counts.sum(axis=1).max())
         cand = np.full((len(old), width), -1, dtype=np.int64)

@@ -70,6 +70,10 @@ class RewrapParams:
     length_sweeps : sweeps of `kitsuke.cloth.restore_lengths` before and after the settle, pins and held strokes
         kept (see WrapParams).
     untangle_rounds : most rounds of `kitsuke.cloth.untangle` at the end (see WrapParams).
+    untangle_iterations : relaxation iterations of each untangle round: 60, as a drag's release, since the re-wrap
+        relaxes the whole garment, whose finest triangles (the wrap refined a kimono's sleeves at the elbows down to
+        2 mm) fold more easily than its 1.5 cm ones (the demo's kimono, hem turned up, on the default body moved by
+        1 nm: 2 folded at an elbow after 30, none after 60).
     polish_rounds : rounds of the wrap's polish after that (`_polish_step`, without refinement), kept only where
         it lowers the max strain with nothing folded (0: none).
     cloth : ClothParams of the relaxation.
@@ -82,6 +86,7 @@ class RewrapParams:
     contact_weight: float = 20.0
     length_sweeps: int = 300
     untangle_rounds: int = 10
+    untangle_iterations: int = 60
     polish_rounds: int = 8
     cloth: ClothParams = field(default_factory=lambda: ClothParams(max_stretch=None))
 
@@ -91,12 +96,13 @@ class RewrapParams:
             and self.close_iterations >= 1
             and self.settle_iterations >= 0
             and self.untangle_rounds >= 0
+            and self.untangle_iterations >= 1
             and self.length_sweeps >= 0
             and self.polish_rounds >= 0
         ):
             raise InputError(
                 "rewrap parameters lift_m >= 0, close_iterations >= 1, settle_iterations >= 0, "
-                "untangle_rounds >= 0, length_sweeps >= 0, polish_rounds >= 0 required"
+                "untangle_rounds >= 0, untangle_iterations >= 1, length_sweeps >= 0, polish_rounds >= 0 required"
             )
         if not self.contact_weight >= 0:
             raise InputError("rewrap parameter contact_weight must be >= 0")
@@ -276,7 +282,7 @@ def rewrap(
     if p.length_sweeps and p.settle_iterations:
         restore_lengths(model, state, collider, sweeps=p.length_sweeps)
     if p.untangle_rounds:
-        untangle(model, state, collider, rounds=p.untangle_rounds)
+        untangle(model, state, collider, rounds=p.untangle_rounds, iterations=p.untangle_iterations)
         folded = folded_faces(model, state)
         if folded.any():
             # A triangle folded against the held stroke row cannot open while the row holds it (the 1.5 cm kimono,
@@ -284,7 +290,7 @@ def rewrap(
             loose = np.zeros(model.n_vertices, dtype=bool)
             loose[model.faces[folded].reshape(-1)] = True
             state.pinned = state.pinned & ~(loose & ~pinned)
-            untangle(model, state, collider, rounds=p.untangle_rounds)
+            untangle(model, state, collider, rounds=p.untangle_rounds, iterations=p.untangle_iterations)
 
     def residual_of(positions: np.ndarray, _refined=None) -> np.ndarray:
         """(S,) metres: each pattern stroke's largest distance (on the garment) from its 3D stroke (the polish here
@@ -303,7 +309,9 @@ def rewrap(
             model,
             state,
             collider,
-            PolishSettings(rounds=p.polish_rounds, untangle_rounds=p.untangle_rounds),
+            PolishSettings(
+                rounds=p.polish_rounds, untangle_rounds=p.untangle_rounds, untangle_iterations=p.untangle_iterations
+            ),
             residual_of=residual_of,
         )
         if kept:
