@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..cloth import ClothModel, RefinedPolish
+from ..cloth import ClothModel, ClothState, RefinedPolish
 from ._place import StrokeTrack
 
 
@@ -56,6 +56,14 @@ def pieces_contiguous(refined: RefinedPolish, piece_faces: np.ndarray) -> PieceO
         level=None if refined.level is None else refined.level[order],
         pending=None if refined.pending is None else refined.pending[order],
     )
+
+
+def reorder_state(state: ClothState, ordered: PieceOrdered) -> ClothState:
+    """`state` (of the refined cloth, in the refinement's face order) with its faces in `ordered`'s order (in
+    place; returned for convenience)."""
+    state.face_active = state.face_active[ordered.order]
+    state._work.clear()  # caches keyed on face_active: its order changed, not its count
+    return state
 
 
 def remap_track(

@@ -80,7 +80,7 @@ from ..metrics import QualityReport, quality_report, strain
 from . import _drag_kernels as K
 from ._drag_field import body_axis, drag_weights, smooth_falloff
 from ._polish_step import PolishSettings, polish_step
-from ._refined import pieces_contiguous
+from ._refined import pieces_contiguous, reorder_state
 from ._solve import GlobalRelax
 from .export import GarmentFile, as_garment_file
 from .wrap import DressedGarment, offset_as_dressed
@@ -397,9 +397,7 @@ class DragSession:
         """Go on with the garment a release's polish refined: faces back in piece order, pins kept (old vertices
         keep their indices), new vertices free."""
         ordered = pieces_contiguous(refined, self._file.piece_faces)
-        state = refined.state
-        state.face_active = state.face_active[ordered.order]
-        state._work.clear()  # caches keyed on face_active: its order changed, not its count
+        state = reorder_state(refined.state, ordered)
         f = self._file
         self._file = GarmentFile(
             state.positions,

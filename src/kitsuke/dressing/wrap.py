@@ -74,7 +74,7 @@ from ._grow import grow
 from ._mend import MendStats, mend_tears
 from ._place import StrokeTrack, place_strokes
 from ._polish_step import PolishSettings, polish_step
-from ._refined import pieces_contiguous, remap_track
+from ._refined import pieces_contiguous, remap_track, reorder_state
 from ._solve import GlobalRelax, gravity_settle
 from ._weld import repair_corners, weld
 from .strokes import Strokes, resolve_strokes
@@ -690,8 +690,7 @@ def wrap(
         state.pinned = np.concatenate([pins, np.zeros(rp.model.n_vertices - len(pins), dtype=bool)])
         if rp.levels:
             ordered = pieces_contiguous(rp, piece_faces)
-            state.face_active = state.face_active[ordered.order]
-            state._work.clear()  # caches keyed on face_active: its order changed, not its count
+            state = reorder_state(state, ordered)
             level, pending = ordered.level, ordered.pending
             tracks = [remap_track(tr, corner_uv, piece_faces, ordered) for tr in tracks]
             out_model, piece_faces, corner_uv = ordered.model, ordered.piece_faces, ordered.corner_uv
