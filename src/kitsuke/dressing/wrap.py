@@ -641,11 +641,19 @@ def wrap(
     # The stroke samples of the garment as it is (out_model, tracks: refined by a kept polish), or of the refined
     # polish rp made of it (its samples moved onto its new faces: between their old corners they lie off the
     # refined surface; the kimono's sleeve crease 12.0 mm from its stroke that way where it measured 8.7 mm).
+    refined_tracks: dict[int, tuple] = {}  # id(rp) -> (its PieceOrdered, the tracks on it): made once, used twice
+
+    def on_refined(rp: RefinedPolish) -> tuple:
+        if id(rp) not in refined_tracks:
+            ordered = pieces_contiguous(rp, piece_faces)
+            refined_tracks.clear()
+            refined_tracks[id(rp)] = (ordered, [remap_track(tr, corner_uv, piece_faces, ordered) for tr in tracks])
+        return refined_tracks[id(rp)]
+
     def residual_of(positions: np.ndarray, rp: RefinedPolish | None = None) -> np.ndarray:
         if rp is None or not rp.levels:
             return np.array([tr.residual_m(positions, out_model.faces) for tr in tracks])
-        ordered = pieces_contiguous(rp, piece_faces)
-        moved = [remap_track(tr, corner_uv, piece_faces, ordered) for tr in tracks]
+        ordered, moved = on_refined(rp)
         return np.array([tr.residual_m(positions, ordered.model.faces) for tr in moved])
 
     settings = PolishSettings(
@@ -689,10 +697,9 @@ def wrap(
         state = rp.state
         state.pinned = np.concatenate([pins, np.zeros(rp.model.n_vertices - len(pins), dtype=bool)])
         if rp.levels:
-            ordered = pieces_contiguous(rp, piece_faces)
+            ordered, tracks = on_refined(rp)
             state = reorder_state(state, ordered)
             level, pending = ordered.level, ordered.pending
-            tracks = [remap_track(tr, corner_uv, piece_faces, ordered) for tr in tracks]
             out_model, piece_faces, corner_uv = ordered.model, ordered.piece_faces, ordered.corner_uv
             if tethers is not None:  # a later pass holds the strokes on the refined faces
                 tethers = Tethers.from_polylines(
