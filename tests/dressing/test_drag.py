@@ -350,5 +350,9 @@ def test_bad_input_raises_and_leaves_the_garment_unchanged(body, skirt, collider
         DragParams(release_polish_iterations=0)
     with pytest.raises(InputError, match="release_polish_above"):
         DragParams(release_polish_above=float("nan"))
+    with pytest.raises(InputError, match="release_polish_levels"):
+        DragParams(release_polish_levels=-1)
+    with pytest.raises(InputError, match="release_polish_max_folds"):
+        DragParams(release_polish_max_folds=1.5)
     with pytest.raises(InputError):
         DragSession(body, "not a garment")

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from ._collide import BodyCollider, collide, layer_planes
+from ._collide import BodyCollider, collide, layer_planes, vertex_active
 from ._lbfgs import minimise
 from ._lengths import restore_lengths
 from ._model import ClothModel, ClothState
@@ -117,9 +117,7 @@ def polish(
     if not rounds:
         return stats
     offset, layer_gap = model.params.contact_offset_m, model.params.layer_gap_m
-    used = np.zeros(model.n_vertices, dtype=bool)
-    used[model.faces[state.face_active].reshape(-1)] = True
-    moving = used & ~state.pinned
+    moving = vertex_active(model, state) & ~state.pinned
     free = np.flatnonzero(moving)
     # Only the terms that touch a moving vertex: the rest are constant (a local polish after a refinement moves a
     # tenth of the garment; its energy over the whole garment made it four times slower).

@@ -321,9 +321,8 @@ def _corner_angles(mesh: PatternMesh) -> tuple[np.ndarray, np.ndarray]:
         ring = np.concatenate([c[:-1] for c in chain])  # the outline, each vertex once, in outline order
         x, y = v[ring, 0], v[ring, 1]
         turn = 1.0 if (x * np.roll(y, -1) - np.roll(x, -1) * y).sum() > 0 else -1.0  # counter-clockwise: +1
-        for c in chain:
-            here, prev = int(c[0]), int(ring[(np.flatnonzero(ring == c[0])[0] - 1) % len(ring)])
-            nxt = int(c[1])
+        for i, c in enumerate(chain):
+            here, nxt, prev = int(c[0]), int(c[1]), int(chain[i - 1][-2])  # the previous edge's last segment
             a, b = v[nxt] - v[here], v[prev] - v[here]
             ang = np.degrees(np.arctan2(turn * (a[0] * b[1] - a[1] * b[0]), a @ b)) % 360.0
             corners.append(here)
