@@ -123,6 +123,10 @@ def test_cli_replays_a_drags_file(cli, body_surface, skirt_obj, tmp_path):
     assert rep["vertices"] == len(before.positions) and len(rep["steps"]) == 2
     assert rep["steps"][0]["updates"] >= 4 and rep["quality_after"]["penetration_count"] == 0
     assert rep["quality_before"]["strain_max"] < 0.01 and rep["update_ms_median"] > 0
+    release = rep["steps"][0]["release"]  # what the release did; the let-go point kept where it was left
+    assert release["release_s"] > 0 and release["grab_gave_m"] == 0 and release["polished"] in (True, False)
+    assert release["strain_max"] == pytest.approx(rep["quality_after"]["strain_max"], abs=1e-5)
+    assert rep["steps"][1]["release"] is None  # the unpin step grabs nothing
     assert png.stat().st_size > 10_000
     assert "wrote" in r.err and "2 steps" in r.err
 

@@ -33,7 +33,7 @@ from ._polyline import (
     surface_length,
     surface_polyline,
 )
-from .drag import DragParams, DragSession, Grab, MoveStats
+from .drag import DragParams, DragSession, Grab, MoveStats, ReleaseStats
 from .drags import (
     Drags,
     DragStep,
@@ -89,6 +89,7 @@ __all__ = [
     "Drags",
     "Grab",
     "MoveStats",
+    "ReleaseStats",
     "StepResult",
     "apply_drags",
     "drags_from_dict",

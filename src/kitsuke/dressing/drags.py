@@ -30,7 +30,7 @@ import numpy as np
 
 from .._files import read_json, write_text_atomic
 from ..errors import InputError
-from .drag import DragSession, MoveStats
+from .drag import DragSession, MoveStats, ReleaseStats
 
 FORMAT = "kitsuke.drags"
 VERSION = 1
@@ -177,13 +177,14 @@ def write_drags(drags: Drags, path: str | os.PathLike[str]) -> None:
 
 @dataclass
 class StepResult:
-    """What one step did: pinned / unpinned vertex indices, the grabbed vertex (-1 if none), and each path
-    point's move (MoveStats)."""
+    """What one step did: pinned / unpinned vertex indices, the grabbed vertex (-1 if none), each path point's
+    move (MoveStats) and the release (ReleaseStats; None without a grab)."""
 
     pinned: list[int] = field(default_factory=list)
     unpinned: list[int] = field(default_factory=list)
     grabbed: int = -1
     moves: list[MoveStats] = field(default_factory=list)
+    release: ReleaseStats | None = None
 
     def to_dict(self) -> dict[str, Any]:
         ups = [t for m in self.moves for t in m.update_seconds]
@@ -197,6 +198,7 @@ class StepResult:
             "max_vertex_move_m": round(max((m.max_vertex_move_m for m in self.moves), default=0.0), 5),
             "update_ms_median": round(1e3 * float(np.median(ups)), 3) if ups else None,
             "update_ms_max": round(1e3 * max(ups), 3) if ups else None,
+            "release": self.release.to_dict() if self.release else None,
         }
 
 
@@ -225,7 +227,7 @@ def apply_drags(session: DragSession, drags: Drags) -> list[StepResult]:
                 r.grabbed = session.grab(step.grab).vertex
                 for q in step.path:
                     r.moves.append(session.move_to(q))
-                session.release()
+                r.release = session.release()
             results.append(r)
     except InputError as e:
         session.restore(snap)
