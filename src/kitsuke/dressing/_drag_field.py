@@ -113,7 +113,7 @@ def body_axis(collider: BodyCollider, point: np.ndarray) -> tuple[np.ndarray, np
         t = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0.0, 1.0)
         foot = a + t[:, None] * ab
         r = radii[:, 0] + t * (radii[:, 1] - radii[:, 0])
-        k = int(np.argmin(np.linalg.norm(p - foot, axis=1) - r))
+        k = int(nearest_capsule(collider, p[None])[0])
         axis = ab[k] / np.linalg.norm(ab[k])
         rel = v - foot[k]
         along = rel @ axis
@@ -124,3 +124,54 @@ def body_axis(collider: BodyCollider, point: np.ndarray) -> tuple[np.ndarray, np
         near = np.abs(v[:, 1] - p[1]) < 0.02
     centre = v[near].mean(axis=0) if near.any() else p
     return axis, centre
+
+
+def nearest_capsule(collider: BodyCollider, points: np.ndarray) -> np.ndarray:
+    """The capsule ("bone") whose surface is nearest each of `points` (n, 3) metres: (n,) int64 (-1 without
+    capsules)."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    ends, radii = collider.capsule_ends, collider.capsule_radii
+    if not len(ends):
+        return np.full(len(p), -1, dtype=np.int64)
+    a, ab = ends[:, 0], ends[:, 1] - ends[:, 0]  # (C, 3)
+    rel = p[:, None, :] - a[None]  # (n, C, 3)
+    t = np.clip(np.einsum("ncj,cj->nc", rel, ab) / np.maximum(np.einsum("cj,cj->c", ab, ab), 1e-300), 0.0, 1.0)
+    gap = np.linalg.norm(rel - t[..., None] * ab[None], axis=2) - (radii[:, 0] + t * (radii[:, 1] - radii[:, 0]))
+    return np.argmin(gap, axis=1).astype(np.int64)
+
+
+#: Capsules whose cloth turns together (a tube round both legs turns with the torso about its axis; a sleeve round
+#: one arm cannot): each arm is a limb of its own, everything else (torso, neck, thighs, shins) the trunk.
+ARM_LIMBS = {"l_upper_arm": 1, "l_forearm": 1, "r_upper_arm": 2, "r_forearm": 2}
+
+
+def capsule_limbs(names: list[str], n_capsules: int) -> np.ndarray:
+    """Each capsule's limb (`ARM_LIMBS`; 0 the trunk): (n_capsules,) int64. Without names (a collider built
+    without a rig's capsules): all 0."""
+    if len(names) != n_capsules:
+        return np.zeros(n_capsules, dtype=np.int64)
+    return np.array([ARM_LIMBS.get(n, 0) for n in names], dtype=np.int64)
+
+
+def turn_weights(model: ClothModel, limb: np.ndarray, near: np.ndarray, grab: int, blend_m: float) -> np.ndarray:
+    """How much of a drag's turn about the grabbed body part's axis each vertex takes: (V,) in [0, 1].
+
+    limb : (V,) int64, the limb (`capsule_limbs`) of each vertex's foot, trusted where `near` (V,) bool (cloth
+    near the body); cloth away from it takes the limb of the nearest such vertex along the cloth (a hanging
+    sleeve is the arm's, wherever its nearest skin is). Cloth on the grab's limb turns (1), blended to 0 over
+    `blend_m` metres of cloth towards cloth on another limb, which does not turn (0): the kimono's body turns
+    about the torso while its sleeves stay round the arms.
+    """
+    from scipy.sparse.csgraph import dijkstra
+
+    if not near.any() or (limb[near] == limb[near][0]).all():
+        return np.ones(model.n_vertices)
+    _, full = _graphs(model, np.zeros(model.n_vertices, dtype=bool))
+    d, _, source = dijkstra(full, directed=True, indices=np.flatnonzero(near), min_only=True, return_predecessors=True)
+    of = np.where(np.isfinite(d), limb[np.maximum(source, 0)], limb[grab])
+    of[near] = limb[near]
+    own = of == of[grab]
+    if own.all():
+        return np.ones(model.n_vertices)
+    d_other = dijkstra(full, directed=True, indices=np.flatnonzero(~own), min_only=True)
+    return np.where(own, smooth_falloff(d_other / blend_m), 0.0)
