@@ -117,6 +117,7 @@ def test_cli_replays_a_drags_file(cli, body_surface, skirt_obj, tmp_path):
     before, after = read_garment_obj(skirt_obj), read_garment_obj(out)
     assert after.name == "skirt" and np.array_equal(after.faces, before.faces)
     np.testing.assert_allclose(after.corner_uv, before.corner_uv, atol=1e-7)  # the rest shape travels on
+    assert before.contact_offset_m is None and after.contact_offset_m == 0.001  # it says what it was dragged at
     lift = after.positions[:, 1] - before.positions[:, 1]
     assert lift.max() > 0.035 and np.median(lift) > 0.005
     rep = json.loads(report.read_text())

@@ -56,6 +56,7 @@ def test_obj_has_pattern_rest_shape_pieces_and_shared_seams(dressed):
     # where the polish refined a fold (up to 4 sqrt(3) levels: a ninth of 1.5 cm and less; measured 0.77 mm).
     rest = g.rest_edge_lengths
     assert rest.min() > 0.0002 and 0.01 < np.median(rest) < 0.02
+    assert g.contact_offset_m == pytest.approx(0.001)  # the shirt's, from `# kitsuke contact_offset_m`
 
 
 def test_report_glb_and_png(dressed):
@@ -147,6 +148,12 @@ def test_dress_a_kimono_pattern_like_the_demo(run_cli, tmp_path):
             assert (layer == (2 if name.endswith("left") else 1)).all(), name
         elif name.startswith("sode"):
             assert not layer.any(), name
+    # So does its contact offset: a kimono lies 3 mm off the body, and a drag of the file keeps it there (at 1 mm
+    # the body showed through between the vertices of a dragged kimono's faces).
+    assert g.contact_offset_m == pytest.approx(0.003)
+    from kitsuke.dressing.drag import DragSession
+
+    assert DragSession(default_body(), g).model.params.contact_offset_m == pytest.approx(0.003)
     summary = json.loads(report.read_text())
     assert summary["held_vertices"] > 100  # the obi band
     assert summary["quality"]["penetration_count"] == 0 and summary["quality"]["inverted_count"] == 0
@@ -165,8 +172,12 @@ def test_read_garment_obj_rejects_plain_meshes(tmp_path):
         ("# kitsuke layer two 0 0", "bad layer line"),
         ("# kitsuke layer 63 0 0", "layer 1..62"),
         ("# kitsuke layer 1 0 5", "layer 1..62"),
+        ("# kitsuke contact_offset_m 3mm", "bad contact offset line"),
+        ("# kitsuke contact_offset_m nan", "0 to 0.05 metres"),
+        ("# kitsuke contact_offset_m -0.001", "0 to 0.05 metres"),
+        ("# kitsuke contact_offset_m 3", "0 to 0.05 metres"),
     ],
-    ids=["not-a-number", "too-high", "past-the-faces"],
+    ids=["not-a-number", "too-high", "past-the-faces", "offset-with-unit", "offset-nan", "offset-negative", "offset-mm"],
 )
 def test_read_garment_obj_rejects_bad_layer_lines(tmp_path, line, text):
     p = tmp_path / "g.obj"

@@ -370,6 +370,7 @@ class DragSession:
         self._capsule_limb = capsule_limbs(names, len(collider.capsule_ends))
         f = self._file
         cloth = offset_as_dressed(garment, self.params.cloth)
+        self._file = dataclasses.replace(self._file, contact_offset_m=cloth.contact_offset_m)  # what it is dragged at
         try:
             self.model = ClothModel.from_corners(
                 f.faces, f.corner_uv, n_vertices=len(f.positions), params=cloth, face_layer=f.face_layer
@@ -457,15 +458,13 @@ class DragSession:
         keep their indices), new vertices free."""
         ordered = pieces_contiguous(refined, self._file.piece_faces)
         state = reorder_state(refined.state, ordered)
-        f = self._file
-        self._file = GarmentFile(
-            state.positions,
-            ordered.model.faces,
-            ordered.corner_uv,
-            f.piece_names,
-            ordered.piece_faces,
-            f.name,
-            ordered.model.face_layer,
+        self._file = dataclasses.replace(
+            self._file,
+            positions=state.positions,
+            faces=ordered.model.faces,
+            corner_uv=ordered.corner_uv,
+            piece_faces=ordered.piece_faces,
+            face_layer=ordered.model.face_layer,
         )
         self.model, self.state = ordered.model, state
         self._refinement = (ordered.level, ordered.pending)

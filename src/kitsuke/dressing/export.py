@@ -3,7 +3,9 @@
 OBJ: `v` world positions (metres); `vt` = each corner's pattern position in metres, piece-local, not normalised (so
 rest lengths can be recovered); `f v/vt`; seam vertices shared (one `v`, a `vt` per side); one comment line
 `# kitsuke piece <name> <first_face> <last_face>` per piece (faces counted from 0, last included); for layered cloth
-(a kimono's fronts) one line `# kitsuke layer <layer> <first_face> <last_face>` per run of faces on a layer above 0.
+(a kimono's fronts) one line `# kitsuke layer <layer> <first_face> <last_face>` per run of faces on a layer above 0;
+`# kitsuke contact_offset_m <metres>`: how far off the body the garment was dressed (a kimono lies 3 mm off, over its
+under-kimonos), so that a drag or re-wrap of the file keeps it there.
 GLB: the same surface split where its UVs differ, UVs normalised to the texture tile, double-sided material,
 optionally the body as a second mesh.
 """
@@ -26,6 +28,9 @@ from .wrap import DressedGarment
 PIECE_TAG = "kitsuke piece"
 LAYER_TAG = "kitsuke layer"
 NAME_TAG = "kitsuke dressed garment"
+OFFSET_TAG = "kitsuke contact_offset_m"
+#: The largest contact offset a garment file may give, metres (cloth 5 cm off the body is not dressed on it).
+MAX_OFFSET_M = 0.05
 
 
 @dataclass
@@ -36,6 +41,7 @@ class GarmentFile:
     piece_names : (P,) names. piece_faces : (P, 2) int64 [start, stop) face ranges.
     name : the garment's name (from the file's `# kitsuke dressed garment <name>` line; "garment" without one).
     face_layer : (F,) int8 cloth layer of each face (`kitsuke.cloth.ClothModel.face_layer`), or None.
+    contact_offset_m : metres off the body it was dressed at (`ClothParams.contact_offset_m`), or None (not said).
     The writers below take a GarmentFile as well as a DressedGarment (a dragged garment is written this way).
     """
 
@@ -46,6 +52,7 @@ class GarmentFile:
     piece_faces: np.ndarray
     name: str = "garment"
     face_layer: np.ndarray | None = None
+    contact_offset_m: float | None = None
 
     @property
     def rest_edge_lengths(self) -> np.ndarray:
@@ -66,6 +73,9 @@ def garment_obj_text(garment: DressedGarment | GarmentFile) -> str:
         for a, b in zip(np.r_[0, cut], np.r_[cut, len(layer)], strict=True):
             if layer[a]:
                 out.write(f"# {LAYER_TAG} {int(layer[a])} {int(a)} {int(b) - 1}\n")
+    offset = garment.model.params.contact_offset_m if isinstance(garment, DressedGarment) else garment.contact_offset_m
+    if offset is not None:
+        out.write(f"# {OFFSET_TAG} {offset:.6g}\n")
     np.savetxt(out, garment.positions, fmt="v %.7f %.7f %.7f")
     np.savetxt(out, garment.corner_uv.reshape(-1, 2), fmt="vt %.7f %.7f")
     f = garment.faces + 1
@@ -93,6 +103,7 @@ def read_garment_obj(path: str | os.PathLike[str]) -> GarmentFile:
         raise InputError("holds NaN or infinite coordinates", path)
     names, ranges, garment_name = [], [], "garment"
     layer = np.zeros(len(data.faces), dtype=np.int8)
+    offset = None
     for line in data.comments:
         if line.startswith(NAME_TAG + " ") and line[len(NAME_TAG) + 1 :].strip():
             garment_name = line[len(NAME_TAG) + 1 :].strip()
@@ -111,6 +122,13 @@ def read_garment_obj(path: str | os.PathLike[str]) -> GarmentFile:
             if not (1 <= value <= MAX_LAYER and 0 <= first <= last < len(data.faces)):
                 raise InputError(f"layer line {line!r}: layer 1..{MAX_LAYER} over faces the file has", path)
             layer[first : last + 1] = value
+        elif line.startswith(OFFSET_TAG + " "):
+            try:
+                offset = float(line[len(OFFSET_TAG) + 1 :])
+            except ValueError:
+                raise InputError(f"bad contact offset line {line!r}", path) from None
+            if not (0 <= offset <= MAX_OFFSET_M):  # also NaN
+                raise InputError(f"contact offset line {line!r}: 0 to {MAX_OFFSET_M} metres", path)
     if not names:
         names, ranges = ["garment"], [(0, len(data.faces))]
     piece_faces = np.array(ranges, dtype=np.int64)
@@ -124,6 +142,7 @@ def read_garment_obj(path: str | os.PathLike[str]) -> GarmentFile:
         piece_faces,
         garment_name,
         layer if layer.any() else None,
+        offset,
     )
 
 
@@ -190,5 +209,6 @@ def as_garment_file(garment: DressedGarment | GarmentFile) -> GarmentFile:
             garment.piece_faces,
             garment.name,
             garment.model.face_layer,
+            garment.model.params.contact_offset_m,
         )
     raise InputError("garment must be a DressedGarment or a GarmentFile (read_garment_obj)")

@@ -400,12 +400,16 @@ class DressedGarment:
 
 
 def offset_as_dressed(garment, cloth: ClothParams) -> ClothParams:
-    """`cloth` with the contact offset a DressedGarment was dressed with, where `cloth` keeps ClothParams' default
-    (a kimono, over its under-kimonos, lies 3 mm off: a drag or re-wrap at 1 mm pulls it in and strains it; the
-    rough drags of tests/dressing/test_drag.py: 0.49 -> 0.94-1.04 % mean strain). A GarmentFile (an OBJ) does not
-    say: `cloth` as it is."""
-    if isinstance(garment, DressedGarment) and cloth.contact_offset_m == ClothParams().contact_offset_m:
-        return dataclasses.replace(cloth, contact_offset_m=garment.model.params.contact_offset_m)
+    """`cloth` with the contact offset a DressedGarment was dressed with, or a GarmentFile's OBJ says, where `cloth`
+    keeps ClothParams' default (a kimono, over its under-kimonos, lies 3 mm off: a drag or re-wrap at 1 mm pulls it
+    in and strains it, and the body shows through between its vertices; the rough drags of
+    tests/dressing/test_drag.py: 0.49 -> 0.94-1.04 % mean strain). A file that does not say: `cloth` as it is."""
+    if isinstance(garment, DressedGarment):
+        offset = garment.model.params.contact_offset_m
+    else:
+        offset = getattr(garment, "contact_offset_m", None)  # a GarmentFile (export imports this module)
+    if offset is not None and cloth.contact_offset_m == ClothParams().contact_offset_m:
+        return dataclasses.replace(cloth, contact_offset_m=offset)
     return cloth
 
 
