@@ -177,9 +177,9 @@ def test_read_garment_obj_rejects_plain_meshes(tmp_path):
         ("# kitsuke contact_offset_m -0.001", "0 to 0.05 metres"),
         ("# kitsuke contact_offset_m 3", "0 to 0.05 metres"),
     ],
-    ids=["not-a-number", "too-high", "past-the-faces", "offset-with-unit", "offset-nan", "offset-negative", "offset-mm"],
+    ids=["not-a-number", "too-high", "past-the-faces", "offset-unit", "offset-nan", "offset-negative", "offset-mm"],
 )
-def test_read_garment_obj_rejects_bad_layer_lines(tmp_path, line, text):
+def test_read_garment_obj_rejects_bad_comment_lines(tmp_path, line, text):
     p = tmp_path / "g.obj"
     p.write_text(f"{line}\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n")
     with pytest.raises(InputError, match=text) as e:
