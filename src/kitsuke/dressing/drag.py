@@ -28,7 +28,8 @@ Per update (one mouse move; `DragSession.update`):
    a skirt dragged sideways turns around the waist, dragged up it rises; a sleeve dragged towards the elbow
    slides along the arm. Cloth on another limb (an arm, when the torso is turned) takes the translation but not
    the turn, faded over 10 cm of cloth (`_drag_field.turn_weights`): the kimono's body turns, its sleeves stay
-   round the arms. Where that move brings a vertex near the body closer to it than it was (the body rises
+   round the arms. Cloth touching the body takes the turn as a belt round it (along the surface's direction
+   round the axis, at the grab's speed), not as a rigid turn that would drive a narrow hem into the ankles. Where that move brings a vertex near the body closer to it than it was (the body rises
    towards it: widening ahead, or a bowl) it is lifted back to its height above its foot (its nearest body point,
    which slides along the surface by the same vector: `_drag_kernels.trace_one`, a straight line on the unfolded
    triangles, equal to potpourri3d's geodesic tracer to 1e-10 m); where the body falls away beneath it
@@ -96,6 +97,9 @@ from .wrap import DressedGarment, offset_as_dressed
 #: Metres above the contact offset that still count as touching the body, for the contact planes of the drag's
 #: global steps (collision leaves touching cloth exactly at the offset).
 CONTACT_ROUNDOFF_M = 2e-4
+#: Where the body's surface faces within asin(this) of the turn's axis (a shoulder's top, a foot's), its direction
+#: round the axis is not defined: cloth there turns rigidly, blended in below this sine.
+BELT_MIN_SIN = 0.5
 
 
 @dataclass(frozen=True)
@@ -780,9 +784,19 @@ class DragSession:
         around = np.cross(ax, r) / radius if radius > 1e-6 else np.zeros(3)
         d_around = float(tangent @ around)
         omega = d_around / radius if radius > 1e-6 else 0.0
-        self._vec[:] = (omega * grab.turn)[:, None] * np.cross(ax, pos - centre) + (tangent - d_around * around)
         # How much each vertex keeps to the body: 1 near it, 0 far from it, smooth between.
         follow = 1.0 - smooth_falloff((np.abs(c.distance) - p.near_m) / (p.far_m - p.near_m))
+        # The turn: cloth that keeps to the body slides round it, along the surface's own direction round the
+        # axis (axis x normal), at the grab's speed, as a belt runs round its pulleys; a rigid turn would drive the
+        # kimono's hem into the ankles it wraps (a narrow tube round two legs is not a circle about the torso's
+        # axis). Cloth away from the body, and where the surface faces along the axis, turns rigidly.
+        spin = np.cross(ax, pos - centre)
+        belt = np.cross(ax, c.normal)
+        belt_len = np.linalg.norm(belt, axis=1)
+        side = np.sign(np.einsum("ij,ij->i", belt, spin)) / np.maximum(belt_len, 1e-12)
+        mix = (follow * smooth_falloff(belt_len / BELT_MIN_SIN))[:, None]
+        spin = (1.0 - mix) * spin + mix * (radius * side)[:, None] * belt
+        self._vec[:] = (omega * grab.turn)[:, None] * spin + (tangent - d_around * around)
         follow[g] = 1.0
         self._vec[g] = tangent
         K.drag_moves(
