@@ -167,7 +167,6 @@ def drag_moves(
     foot_bary,
     foot_point,
     out_move,
-    crease_cos,
 ):
     """Move every vertex by its weighted drag vector (in place on pos), along the body where it is near it.
 
@@ -177,8 +176,7 @@ def drag_moves(
     after the move) that far along the surface, and where the translation brought it closer to the body than it
     was (the body rises towards it), it is lifted back to its height above the new foot, along the normal there
     (times follow); where the body falls away beneath it, it goes straight on and bridges the gap, as cloth
-    does. Where the foot's surface normal turned to a cosine below crease_cos and faces back against the move, the
-    foot ran into a crease: the vertex and its foot stay (move 0). out_move (V, 3): the move of each vertex, metres.
+    does. out_move (V, 3): the move of each vertex, metres.
     """
     for i in prange(pos.shape[0]):
         w = weight[i]
@@ -195,11 +193,6 @@ def drag_moves(
             g, c0, c1, c2, _ = trace_one(bv, bf, face_adj, face_n, f, b0, b1, b2, mx, my, mz, max_cross)
             px, py, pz = _point(bv, bf, g, c0, c1, c2)
             qx, qy, qz = _interp_unit(vert_n, bf, g, c0, c1, c2)
-            if nx * qx + ny * qy + nz * qz < crease_cos and qx * mx + qy * my + qz * mz < 0.0:
-                # The foot went into a crease (the surface ahead turned sharply and faces back at the move: an
-                # armpit from the torso's side): the cloth is blocked there and stays.
-                out_move[i, 0], out_move[i, 1], out_move[i, 2] = 0.0, 0.0, 0.0
-                continue
             # Height of the translated vertex above the new foot's tangent plane.
             hn = (pos[i, 0] + mx - px) * qx + (pos[i, 1] + my - py) * qy + (pos[i, 2] + mz - pz) * qz
             if hn < h:

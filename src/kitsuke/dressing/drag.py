@@ -118,12 +118,6 @@ class DragParams:
     near_m, far_m : metres. Cloth nearer the body than near_m keeps to it (lifted back to its height where the
         body rises towards it); cloth farther than far_m is only translated; smoothly blended between.
     falloff : "smooth" (S(t) = 3t² - 2t³: no kink at the grab or at a pin) or "linear" (t itself).
-    crease_deg : degrees. A vertex that keeps to the body and whose foot, moved along the surface, finds the
-        surface turned by more than this and facing back against the move has run into a crease (up the torso's
-        side into an armpit): it stays where it is for that update, as cloth bunches below a crease instead of
-        going into it. Measured on GarmentCode's shirt on its mean_all body, the front hem lifted 5 cm against a
-        pin in the upper back: 34 % max strain after the release without it (cloth pushed into the armpits and
-        thrown out of them by collision), 5.7 % with 60, 6.2 % with 45.4 (cos 0.7). 180: never.
     turn_blend_m : metres of cloth over which a drag's turn about the grabbed body part fades out towards cloth on
         another limb (an arm, when the torso is turned: `_drag_field.turn_weights`). Cloth on a limb of its own
         takes the drag's translation but not the turn: turned about the torso, a kimono's sleeves would be swept
@@ -192,7 +186,6 @@ class DragParams:
     far_m: float = 0.04
     falloff: Literal["smooth", "linear"] = "smooth"
     turn_blend_m: float = 0.1
-    crease_deg: float = 60.0
     contact_weight: float = 20.0
     contact_iterations: int = 5
     max_relax_move_m: float = 0.01
@@ -253,8 +246,6 @@ class DragParams:
             and list(give) == sorted(give)
         ):
             raise InputError(f"drag parameter release_give_m must be a tuple of increasing metres > 0, got {give!r}")
-        if not (math.isfinite(self.crease_deg) and 0 < self.crease_deg <= 180):
-            raise InputError(f"drag parameter crease_deg must be in (0, 180] degrees, got {self.crease_deg!r}")
         if not (math.isfinite(self.contact_weight) and self.contact_weight >= 0):
             raise InputError(f"drag parameter contact_weight must be a finite number >= 0, got {self.contact_weight!r}")
         if not (0 <= self.near_m < self.far_m and math.isfinite(self.far_m)):
@@ -825,7 +816,6 @@ class DragSession:
         K.drag_moves(
             pos, grab.weight, follow, self._vec, col.vertices, col.faces, col.face_adjacency, col.face_normals,
             col.vertex_normals, p.max_crossings, c.face, c.bary, c.point, self._move,
-            math.cos(math.radians(p.crease_deg)),
         )  # fmt: skip
         if target is not None:  # the grab's foot ends exactly on its target, the grab at its height above it
             f, bary, point = target
