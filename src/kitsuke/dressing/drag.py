@@ -632,7 +632,8 @@ class DragSession:
         with g held; if that leaves the max strain above `release_polish_above`, with g tethered within each of
         `release_give_m` in turn; if none of those is kept, once more held without refinement (refining cloth
         crushed into an armpit can tear it: GarmentCode's shirt, its front hem lifted 5 cm against a pin in the
-        back, 50.8 % max strain; every refined polish tore it, the unrefined one left 34 %). Returns the first
+        back, 50.8 % max strain; every refined polish tore it, the unrefined one left 34 %; with the body moved by
+        1 nm the refined one was kept, 6-9 %: the fallback is for the unlucky case). Returns the first
         result that meets the target, else the kept one with the lowest max strain, else None (nothing kept)."""
         p = self.params
         settings = PolishSettings(
