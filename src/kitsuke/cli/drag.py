@@ -15,10 +15,13 @@ vt = pattern metres: the rest shape). DRAGS is a kitsuke drags JSON (SPEC 3.5): 
 at a point ("grab") and moving the grab through "path" points (each projected onto the body); the whole garment
 follows along the body, attenuated towards the pins and not past them. All points in metres, Y up.
 
-Outputs: OUT.obj, the dragged garment in the same OBJ layout (so it can be dragged again); --report a JSON with
-the quality before and after (penetration, strain, seam gap, inverted triangles), what each step did and the update
-timings; --png a front/side/back picture. Nothing is written if any step fails (e.g. a grab off the garment, a
-path point off the body, every vertex pinned): the error names the drags file and the step.
+Outputs: OUT.obj, the dragged garment in the same OBJ layout (so it can be dragged again; a release may refine
+it where the drag bunched the cloth: more vertices, the old ones keep their indices); --report a JSON with the
+quality before and after (penetration, strain, seam gap, inverted triangles), what each step did (pins, the grab,
+its updates and timings, and its release: the polish, new vertices, how far the let-go point gave back where the
+cloth was too taut to stay) and the update timings; --png a front/side/back picture. Nothing is written if any
+step fails (e.g. a grab off the garment, a path point off the body, every vertex pinned): the error names the
+drags file and the step.
 
 examples:
   kitsuke dress --body default --pattern kimono.json --strokes kimono_default.json -o k.glb --obj kimono.obj
