@@ -402,6 +402,9 @@ def test_bad_input_raises_and_leaves_the_garment_unchanged(body, skirt, collider
         DragParams(release_polish_levels=-1)
     with pytest.raises(InputError, match="release_polish_max_folds"):
         DragParams(release_polish_max_folds=1.5)
+    for blend in (0.0, -0.1, float("inf")):
+        with pytest.raises(InputError, match="turn_blend_m"):
+            DragParams(turn_blend_m=blend)
     for give in ((0.02, 0.01), (0.0,), (float("nan"),), [0.01]):
         with pytest.raises(InputError, match="release_give_m"):
             DragParams(release_give_m=give)

@@ -108,17 +108,16 @@ def body_axis(collider: BodyCollider, point: np.ndarray) -> tuple[np.ndarray, np
     v = collider.vertices
     ends, radii = collider.capsule_ends, collider.capsule_radii
     if len(ends):
-        a, b = ends[:, 0], ends[:, 1]
-        ab = b - a
-        t = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0.0, 1.0)
-        foot = a + t[:, None] * ab
-        r = radii[:, 0] + t * (radii[:, 1] - radii[:, 0])
         k = int(nearest_capsule(collider, p[None])[0])
-        axis = ab[k] / np.linalg.norm(ab[k])
-        rel = v - foot[k]
+        a, ab = ends[k, 0], ends[k, 1] - ends[k, 0]
+        t = float(np.clip((p - a) @ ab / max(ab @ ab, 1e-300), 0.0, 1.0))
+        foot = a + t * ab
+        r = radii[k, 0] + t * (radii[k, 1] - radii[k, 0])
+        axis = ab / np.linalg.norm(ab)
+        rel = v - foot
         along = rel @ axis
         radial = np.linalg.norm(rel - along[:, None] * axis, axis=1)
-        near = (np.abs(along - (p - foot[k]) @ axis) < 0.02) & (radial < AXIS_REACH * max(r[k], 0.01) + 0.02)
+        near = (np.abs(along - (p - foot) @ axis) < 0.02) & (radial < AXIS_REACH * max(r, 0.01) + 0.02)
     else:
         axis = np.array([0.0, 1.0, 0.0])
         near = np.abs(v[:, 1] - p[1]) < 0.02

@@ -605,25 +605,22 @@ class DragSession:
             )
         m = self.model
         stats = ReleaseStats(strain_max=strain(self.state.positions, m.edges, m.rest_lengths).max)
-        if p.release_polish_rounds and stats.strain_max > p.release_polish_above:
-            let_go = self.state.positions[g].copy()
-            polished = self._release_polish(g)
-            if polished is not None:
-                stats.polished = True
-                stats.new_vertices = polished.model.n_vertices - m.n_vertices
-                if polished.levels:
-                    self._adopt(polished)  # new feet, tracked
-                else:
-                    self.state.positions[:] = polished.state.positions
-                    self.state.contacts = polished.state.contacts
-                    self._track_feet()
-                self.state.pinned = np.concatenate([held, np.zeros(self.n_vertices - len(held), dtype=bool)])
-                stats.grab_gave_m = float(np.linalg.norm(self.state.positions[g] - let_go))
-                stats.strain_max = strain(self.state.positions, self.model.edges, self.model.rest_lengths).max
-            else:
-                self._track_feet()
+        let_go = self.state.positions[g].copy()
+        polish = p.release_polish_rounds and stats.strain_max > p.release_polish_above
+        polished = self._release_polish(g) if polish else None
+        if polished is not None and polished.levels:
+            self._adopt(polished)  # new feet, tracked
         else:
+            if polished is not None:
+                self.state.positions[:] = polished.state.positions
+                self.state.contacts = polished.state.contacts
             self._track_feet()
+        if polished is not None:
+            stats.polished = True
+            stats.new_vertices = self.n_vertices - m.n_vertices
+            self.state.pinned = np.concatenate([held, np.zeros(self.n_vertices - len(held), dtype=bool)])
+            stats.grab_gave_m = float(np.linalg.norm(self.state.positions[g] - let_go))
+            stats.strain_max = strain(self.state.positions, self.model.edges, self.model.rest_lengths).max
         stats.seconds = time.perf_counter() - t0
         return stats
 
