@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-from kitsuke.dressing import arc_length, interpolate_polyline, strokes_from_dict, write_strokes
+from kitsuke.dressing import arc_length, in_file_frame, interpolate_polyline, strokes_from_dict, write_strokes
 from kitsuke.geometry import TriMesh
 from kitsuke.pattern import Pattern, Piece
 
@@ -243,10 +243,13 @@ def length_ratio(p: dict) -> float:
     )
 
 
-def write_strokes_file(pairs: list[dict], meta: dict, out: str) -> None:
-    """Validate the pairs as a kitsuke strokes v1 document and write it (atomically), printing a summary."""
+def write_strokes_file(pairs: list[dict], meta: dict, out: str, pattern: Pattern | None = None) -> None:
+    """Validate the pairs (pattern points in the pieces' own coordinates) as a kitsuke strokes v1 document and
+    write it (atomically) in the coordinates of `pattern`'s file (GarmentCode's back panels mirrored back),
+    printing a summary."""
     doc = {"format": "kitsuke.strokes", "version": 1, "target": "body", "pairs": pairs, "meta": meta}
-    write_strokes(strokes_from_dict(doc), out)
+    strokes = strokes_from_dict(doc)
+    write_strokes(strokes if pattern is None else in_file_frame(strokes, pattern), out)
     for p in pairs:
         pts = np.array(p["pattern"]["points"])
         print(

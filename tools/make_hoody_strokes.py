@@ -110,6 +110,7 @@ def main(out: str) -> None:
             "as its body stroke",
         },
         out,
+        pat,
     )
 
 

@@ -108,6 +108,7 @@ def main(out: str) -> None:
             "body stroke",
         },
         out,
+        pat,
     )
 
 

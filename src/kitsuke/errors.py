@@ -1,7 +1,9 @@
 """Error types shared by the library and the command line.
 
 `InputError` is what bad input raises anywhere in kitsuke; the CLI turns it into one line on stderr and exit code 2.
-Anything else escaping to the CLI is an internal error (exit code 1).
+`ComputationError` is a computation that gave no usable result (diverged, non-finite, not a garment on the body);
+the CLI says which stage failed in one line, writes nothing as if it worked, and exits with code 1. Anything else
+escaping to the CLI is an internal error (exit code 1).
 """
 
 from __future__ import annotations
@@ -26,3 +28,21 @@ class InputError(KitsukeError, ValueError):
         self.message = message
         self.path = None if path is None else str(path)
         super().__init__(f"{self.path}: {message}" if self.path else message)
+
+
+class ComputationError(KitsukeError, RuntimeError):
+    """A computation that gave no usable result: it diverged, went non-finite, or its result is not what it
+    should be (a garment that is not on the body).
+
+    Parameters
+    ----------
+    stage : the step that failed ("length restoration", "wrap: close", ...).
+    message : what went wrong, one line, naming the piece or stroke where there is one.
+    result : the unusable result, for inspection (`kitsuke dress --keep-failed` writes it), or None.
+    """
+
+    def __init__(self, stage: str, message: str, *, result: object = None):
+        self.stage = stage
+        self.message = message
+        self.result = result
+        super().__init__(f"{stage}: {message}")

@@ -1,8 +1,9 @@
 """The `kitsuke` command: `kitsuke <group> <verb> ...`.
 
 Thin by design: each group module (`cli/<group>.py`) parses its arguments and calls the library. Errors follow SPEC §2:
-bad input -> one line on stderr naming the file and the problem, exit code 2; an internal error -> exit code 1
-(set KITSUKE_DEBUG=1 for the traceback).
+bad input -> one line on stderr naming the file and the problem, exit code 2; a computation that gave no usable
+result (diverged, not a garment on the body) -> one line naming the stage, exit code 1, nothing written as if it
+worked; an internal error -> exit code 1 (set KITSUKE_DEBUG=1 for the traceback).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import os
 import sys
 import traceback
 
-from ..errors import InputError
+from ..errors import ComputationError, InputError
 
 #: group name -> (module under kitsuke.cli, one-line help). Modules are imported only when their group runs or
 #: when `--help` lists them, so `kitsuke --help` stays fast.
@@ -21,6 +22,7 @@ GROUPS: dict[str, tuple[str, str]] = {
     "demo": ("demo", "write the default body, kimono pattern and renders to out/"),
     "body": ("body", "inspect and convert body meshes"),
     "pattern": ("pattern", "convert, validate, mesh and generate sewing patterns"),
+    "strokes": ("strokes", "propose a stroke set from a pattern's placement, or check a strokes file"),
     "dress": ("dress", "put a garment on a body from a pattern and stroke pairs (wrap + settle), or re-wrap it"),
     "drag": ("drag", "drag a dressed garment along the body, with pins (replays a drags file)"),
     "render": ("render", "render meshes to PNG"),
@@ -34,6 +36,8 @@ examples:
   kitsuke pattern kimono -o kimono.json          # standard-size kimono pattern
   kitsuke pattern convert shirt_spec.json shirt.svg
   kitsuke pattern mesh kimono.json -o kimono.obj
+  kitsuke strokes suggest --body mean_all.obj --pattern shirt_spec.json -o strokes.json
+  kitsuke dress --body mean_all.obj --pattern shirt_spec.json --strokes strokes.json -o shirt.glb
   kitsuke render body.glb -o front.png --view front
   kitsuke pose extract clip.mp4 -o poses.json    # MediaPipe, bundled model; also BVH, images, --camera 0
   kitsuke pose correct clip.mp4 -o fixed.json --plot legs.png --video overlay.mp4
@@ -84,6 +88,9 @@ def main(argv: list[str] | None = None) -> int:
     except InputError as e:
         print(f"kitsuke: error: {e}", file=sys.stderr)
         return 2
+    except ComputationError as e:
+        print(f"kitsuke: failed: {e}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("kitsuke: interrupted", file=sys.stderr)
         return 130

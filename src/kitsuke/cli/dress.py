@@ -24,7 +24,10 @@ the arms (--hang 2) and, on a rigged body (`default`), its waist is held where t
 Outputs: OUT.glb for viewers (garment, double-sided, plus the body); --obj the checkable OBJ (v = world metres,
 vt = pattern metres, seam vertices shared, one `# kitsuke piece` line per piece); --report the quality report (JSON:
 penetration, strain, seam gap, inverted triangles, stroke residuals, timings); --png a front/side/back picture.
-The command exits 0 when the garment is written, whether or not every quality target is met: read the report.
+The command exits 0 when the garment is written, whether or not every quality target is met: the targets it
+misses are said on stderr and in the report ("targets_missed"). When the result is not a garment on the body
+(non-finite, a piece off the body, torn cloth, a stroke far from where it was drawn) it exits 1 with one line
+naming the stage and the piece or stroke, and writes nothing (--keep-failed writes it as OUT.failed.glb ...).
 
 Re-wrap: give --garment (a dressed OBJ written by --obj) instead of --pattern, and a strokes file with
 "target": "garment" (its pattern strokes on the garment's pieces, cm; its 3D strokes drawn on the garment where
@@ -55,6 +58,12 @@ def register(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--obj", metavar="OUT.obj", help="also write the SPEC 3.3 OBJ (vt = pattern metres)")
     parser.add_argument("--report", metavar="REPORT.json", help="also write the quality report")
     parser.add_argument("--png", metavar="VIEWS.png", help="also write a front/side/back picture")
+    parser.add_argument(
+        "--keep-failed",
+        action="store_true",
+        help="when the wrap fails (exit 1: the result is not a garment on the body), still write what it made, "
+        "as OUT.failed.glb (and .failed.obj / .json / .png), for inspection",
+    )
     parser.add_argument(
         "--pin",
         action="append",
@@ -105,18 +114,19 @@ def register(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..dressing import check_strokes, read_strokes
-    from ..dressing.export import write_garment_glb, write_garment_obj, write_garment_png, write_garment_report
+    from ..dressing import check_strokes, read_strokes, target_misses
     from ..dressing.kimono import is_kimono, kimono_params
-    from ..dressing.wrap import WrapParams, wrap
-    from ..errors import InputError
+    from ..dressing.wrap import DressedGarment, WrapParams, wrap
+    from ..errors import ComputationError, InputError
     from ..pattern import load_pattern
 
     inputs = [args.body, args.pattern or args.garment, args.strokes]
-    outs = [checked_output(args.output, inputs, suffixes=(".glb",))]
-    for extra, suffix in ((args.obj, ".obj"), (args.report, ".json"), (args.png, ".png")):
-        if extra:
-            outs.append(checked_output(extra, inputs, suffixes=(suffix,)))
+    glb = checked_output(args.output, inputs, suffixes=(".glb",))
+    obj, report, png = (
+        checked_output(extra, inputs, suffixes=(suffix,)) if extra else None
+        for extra, suffix in ((args.obj, ".obj"), (args.report, ".json"), (args.png, ".png"))
+    )
+    outs = [o for o in (glb, obj, report, png) if o is not None]
     if len({o.resolve() for o in outs}) != len(outs):
         raise InputError("the output files must be different")
     if not 0.2 <= args.edge_length <= 10:
@@ -147,21 +157,35 @@ def run(args: argparse.Namespace) -> int:
         params = dataclasses.replace(params, polish_rounds=0)
     if is_kimono(pattern):
         params = kimono_params(body, params, hang=args.hang)
-    garment = wrap(body, pattern, strokes, params=params)
-    write_garment_glb(garment, outs[0], body=body.mesh)
-    if args.obj:
-        write_garment_obj(garment, args.obj)
-    if args.report:
-        write_garment_report(garment, args.report)
-    if args.png:
-        write_garment_png(garment, body.mesh, args.png)
-    r = garment.report
-    verdict = "" if r is None else ("all quality targets met" if r.ok else "targets missed: " + ", ".join(r.failures()))
+    try:
+        garment = wrap(body, pattern, strokes, params=params)
+    except ComputationError as e:
+        if args.keep_failed and isinstance(e.result, DressedGarment):
+            failed = [None if o is None else o.with_suffix(".failed" + o.suffix) for o in (glb, obj, report, png)]
+            _write(e.result, body, *failed)
+            print(f"kept the failed result as {failed[0]} for inspection", file=sys.stderr)
+        raise
+    _write(garment, body, glb, obj, report, png)
+    misses = target_misses(garment)
+    verdict = "all quality targets met" if not misses else "targets missed: " + "; ".join(misses)
     print(
         f"wrote {args.output}: {garment.n_vertices} vertices, wrap {garment.timings.get('wrap', 0.0):.2f} s; {verdict}",
         file=sys.stderr,
     )
     return 0
+
+
+def _write(garment, body, glb, obj=None, report=None, png=None) -> None:
+    """The dressed garment's outputs (GLB always; OBJ, report, PNG where a path is given)."""
+    from ..dressing.export import write_garment_glb, write_garment_obj, write_garment_png, write_garment_report
+
+    write_garment_glb(garment, glb, body=body.mesh)
+    if obj:
+        write_garment_obj(garment, obj)
+    if report:
+        write_garment_report(garment, report)
+    if png:
+        write_garment_png(garment, body.mesh, png)
 
 
 def _pin_points(values: list[str]) -> list[list[float]]:

@@ -98,8 +98,9 @@ def register(parser: argparse.ArgumentParser) -> None:
         "validate",
         "check a pattern; exit 2 on errors, list warnings",
         "Check a pattern file. Errors (unreadable file, self-intersecting or zero-area outline, clockwise "
-        "outline, seams naming unknown pieces or edges, duplicate names) give one line on stderr and exit "
-        "code 2; warnings (seam edges differing by more than 1 %) are printed and the exit code is 0.",
+        "outline, seams naming unknown pieces or edges, duplicate names, seams that cannot be sewn into one "
+        "garment surface, which `kitsuke dress` would refuse) give one line on stderr and exit code 2; "
+        "warnings (seam edges differing by more than 1 %) are printed and the exit code is 0.",
         FORMATS + "\nexample:\n  kitsuke pattern validate my_pattern.json\n",
     )
     p.add_argument("pattern", metavar="PATTERN", help="pattern file")
@@ -291,9 +292,15 @@ def run_info(args: argparse.Namespace) -> int:
 
 
 def run_validate(args: argparse.Namespace) -> int:
+    from ..dressing import check_sewable
+    from ..errors import InputError
     from ..pattern import load_pattern_with_issues
 
     pattern, issues = load_pattern_with_issues(args.pattern)
+    try:
+        check_sewable(pattern)  # what `dress` meshes and sews: the same refusals, here
+    except InputError as e:
+        raise InputError(e.message, args.pattern) from None
     _print_warnings(issues)
     print(
         f"{args.pattern}: ok: {len(pattern.pieces)} pieces, {len(pattern.seams)} seams, "

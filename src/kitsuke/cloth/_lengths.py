@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import ComputationError, InputError
 from . import _kernels as K
 from ._collide import BodyCollider, active_edge_index, collide, vertex_active
 from ._model import ClothModel, ClothState
@@ -40,13 +40,15 @@ class LengthStats:
 
     sweeps : sweeps run. worst_error_m : the largest edge length error met in the last sweep, metres.
     searches : global nearest-point searches of the collision updates. worst_tether_m : the farthest a tethered
-    point was beyond its reach in the last sweep, metres.
+    point was beyond its reach in the last sweep, metres. restarted : the accelerated sweeps ran away (see
+    `restore_lengths`) and were run again plain from the start.
     """
 
     sweeps: int = 0
     worst_error_m: float = 0.0
     worst_tether_m: float = 0.0
     searches: int = 0
+    restarted: bool = False
 
 
 def restore_lengths(
@@ -110,6 +112,56 @@ def restore_lengths(
         raise InputError("tethers must be a kitsuke.cloth.Tethers or None")
     if tethers is not None and len(tethers) and tethers.tri.max() >= model.n_vertices:
         raise InputError("tethers name cloth vertices the model does not have")
+    start_positions = state.positions.copy()
+    stats = _sweep(
+        model,
+        state,
+        collider,
+        sweeps,
+        collide_every,
+        tolerance_m,
+        tethers,
+        over_relaxation,
+        chebyshev_rho,
+        band,
+        search_first,
+    )
+    if stats is None:  # ran away: again from the start, neither accelerated nor over-relaxed
+        state.positions[:] = start_positions
+        state.contacts.forget()
+        stats = _sweep(
+            model, state, collider, sweeps, collide_every, tolerance_m, tethers, 1.0, None, band, search_first
+        )
+        if stats is None:
+            raise ComputationError("length restoration", "edge projection ran away (non-finite or metres of motion)")
+        stats.restarted = True
+    return stats
+
+
+#: Sweeps that move any vertex farther than this from where they started ran away (metres; a wrap's length
+#: restoration moves cloth millimetres to a few centimetres).
+RUNAWAY_M = 0.5
+#: ... or whose worst edge error grows past this many times the largest seen in the first sweeps (at least 1 cm).
+RUNAWAY_GROWTH = 10.0
+
+
+def _sweep(
+    model,
+    state,
+    collider,
+    sweeps,
+    collide_every,
+    tolerance_m,
+    tethers,
+    over_relaxation,
+    chebyshev_rho,
+    band,
+    search_first,
+) -> LengthStats | None:
+    """The sweeps of `restore_lengths`; None when they run away (Chebyshev extrapolation fighting tethers or pins
+    can grow without bound: GarmentCode's shirt on strokes drawn from its placement reached 1e18 m): a
+    non-finite position, a vertex RUNAWAY_M from its start, or an edge error RUNAWAY_GROWTH times the first
+    sweeps' worst."""
     movable = vertex_active(model, state) & ~state.pinned
     forward = active_edge_index(model, state)
     forward = forward[movable[model.edges[forward]].any(axis=1)]  # an edge with both ends held cannot move
@@ -123,6 +175,7 @@ def restore_lengths(
     if accelerate:
         older, start = pos.copy(), np.empty_like(pos)  # the iterates one and two sweeps back
         rho2, weight = chebyshev_rho * chebyshev_rho, 1.0
+    origin, first_worst = pos.copy(), 0.0
     for s in range(sweeps):
         plain = s >= sweeps - PLAIN_FINISH
         if accelerate:
@@ -148,6 +201,12 @@ def restore_lengths(
         if accelerate:
             older, start = start, older
         stats.sweeps += 1
+        if s < CHEBYSHEV_DELAY:
+            first_worst = max(first_worst, stats.worst_error_m)
+        elif not stats.worst_error_m <= RUNAWAY_GROWTH * max(first_worst, 0.01) or (
+            s % 16 == 0 and not _bounded(pos, origin)
+        ):
+            return None
         last = s == sweeps - 1 or max(stats.worst_error_m, stats.worst_tether_m) <= tolerance_m
         if collider is not None and ((s + 1) % collide_every == 0 or last):
             if last and not search_first:
@@ -155,4 +214,13 @@ def restore_lengths(
             stats.searches += collide(model, state, collider).searches
         if last:
             break
+    if not _bounded(pos, origin):
+        return None
     return stats
+
+
+def _bounded(pos: np.ndarray, origin: np.ndarray) -> bool:
+    """Every position finite and within RUNAWAY_M of where it started."""
+    d = pos - origin
+    worst = float(np.einsum("ij,ij->i", d, d).max(initial=0.0))
+    return bool(np.isfinite(worst) and worst <= RUNAWAY_M * RUNAWAY_M)

@@ -33,6 +33,7 @@ from ._polyline import (
     surface_length,
     surface_polyline,
 )
+from ._weld import check_sewable
 from .drag import DragParams, DragSession, Grab, MoveStats, ReleaseStats
 from .drags import (
     Drags,
@@ -45,6 +46,8 @@ from .drags import (
     read_drags,
     write_drags,
 )
+from .outcome import on_body_failures, target_misses
+from .perturb import HandPerturbation, perturb_strokes
 from .strokes import (
     FORMAT,
     MAX_SURFACE_DISTANCE_M,
@@ -55,6 +58,8 @@ from .strokes import (
     StrokePair,
     Strokes,
     check_strokes,
+    in_file_frame,
+    in_piece_frame,
     read_strokes,
     resolve_strokes,
     strokes_from_dict,
@@ -63,6 +68,7 @@ from .strokes import (
     triangles_crossed,
     write_strokes,
 )
+from .suggest import SuggestParams, suggest_strokes
 from .wrap import DressedGarment, WrapParams, wrap
 
 
@@ -83,6 +89,13 @@ def load_packaged_strokes(name: str = "kimono_default") -> Strokes:
 
 
 __all__ = [
+    "check_sewable",
+    "HandPerturbation",
+    "SuggestParams",
+    "on_body_failures",
+    "perturb_strokes",
+    "suggest_strokes",
+    "target_misses",
     "DragParams",
     "DragSession",
     "DragStep",
@@ -111,6 +124,8 @@ __all__ = [
     "arc_length",
     "arc_parameters",
     "check_strokes",
+    "in_file_frame",
+    "in_piece_frame",
     "densify_polyline",
     "interpolate_polyline",
     "load_packaged_strokes",

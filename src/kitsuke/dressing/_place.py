@@ -1,10 +1,18 @@
 """Wrap step 1: the pattern triangles each pattern stroke crosses are laid onto the body along its body stroke.
 
-Arc-length correspondence: a pattern point at arc-length fraction t along its pattern stroke goes to the body
-stroke's point at the same fraction t (so the whole pattern stroke lies on the whole body stroke). Its signed
-distance across the stroke is laid out along the body surface perpendicular to the stroke (the direction
-normal x tangent, which is "left" of the stroke seen from outside, matching the pattern's left seen from the
-piece's outer face), then projected back onto the surface and lifted `lift_m` off it along the normal.
+A stroke says *where* the cloth lies, not how long it is: the pattern stroke keeps its own length and is laid
+along the body stroke with their middles together (a pattern point s cm along its stroke goes s / 100 m along
+the body stroke from where the pattern stroke starts, the body stroke continued straight past its ends where the
+pattern stroke is longer). Stretching the pattern stroke to the body stroke's length, as the paper's arc-length
+correspondence does, strains the placed cloth by the ratio of the two, which a hand does not keep at 1 (a body
+stroke 10 % short: 31 % max strain after the wrap; 30 %: 179 %).
+
+Its signed distance across the stroke is laid out along the body surface perpendicular to the stroke (the
+direction normal x tangent, which is "left" of the stroke seen from outside, matching the pattern's left seen
+from the piece's outer face), then projected back onto the surface and lifted `lift_m` off it along the normal.
+
+Strokes may be drawn either way: where the pattern's placement (or, without one, the pattern's up, +y) says the
+pattern stroke runs against its body stroke, the body stroke is taken the other way round (`stroke_reversed`).
 """
 
 from __future__ import annotations
@@ -17,6 +25,7 @@ from ..cloth import BodyCollider
 from ..errors import InputError
 from ..geometry.surface import Surface
 from ..pattern import PatternMesh
+from ..pattern import Placement as PiecePlacement
 from ._polyline import (
     arc_length,
     interpolate_polyline,
@@ -38,8 +47,11 @@ class StrokeTrack:
     """Where a pattern stroke lies on the garment and which body path it must follow.
 
     id : stroke id. faces : (n,) int64 garment faces holding the stroke's samples; bary : (n, 3) their
-    barycentric coordinates. body_path : (k, 3) float64 metres, the body stroke traced on the surface.
-    pattern_length_m, body_length_m : the two strokes' lengths, metres.
+    barycentric coordinates. body_path : (k, 3) float64 metres, the body stroke traced on the surface, in the
+    direction it was taken (see `reversed`), continued along the surface past its ends where the pattern stroke
+    is longer (what the cloth stroke is held to and measured against).
+    pattern_length_m, body_length_m : the two strokes' lengths, metres (the body stroke as drawn).
+    reversed : the body stroke was taken against its drawing order (`stroke_reversed`).
     """
 
     id: int
@@ -48,6 +60,7 @@ class StrokeTrack:
     body_path: np.ndarray
     pattern_length_m: float
     body_length_m: float
+    reversed: bool = False
 
     def points(self, positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
         """(n, 3) the stroke's samples on the garment at `positions` (V, 3)."""
@@ -129,6 +142,48 @@ def locate_in_triangles(tri: np.ndarray, faces: np.ndarray, points_cm: np.ndarra
     return faces[best], bc / bc.sum(axis=1, keepdims=True)
 
 
+#: A pattern stroke runs against its body stroke when the cosine of their directions is below minus this.
+AGAINST_COS = 0.3
+
+
+def stroke_reversed(pattern_points: np.ndarray, body_path: np.ndarray, placement: PiecePlacement | None) -> bool:
+    """Whether a body stroke (k, 3) metres was drawn the other way from its pattern stroke (n, 2) cm.
+
+    With the piece's placement the pattern stroke's direction is carried into the world and compared with the
+    body stroke's (end minus start); without one, the pattern's up (+y) is compared with the world's (+Y), and
+    only strokes that run clearly up or down (cosine over 0.5 with the vertical on both sides) are judged."""
+    dp = pattern_points[-1] - pattern_points[0]
+    db = body_path[-1] - body_path[0]
+    nb = float(np.linalg.norm(db))
+    if nb < 1e-9 or float(np.hypot(*dp)) < 1e-9:
+        return False
+    if placement is not None:
+        ends = placement.apply(pattern_points[[0, -1]])
+        d3 = ends[1] - ends[0]
+        n3 = float(np.linalg.norm(d3))
+        return n3 > 1e-9 and float(d3 @ db) / (n3 * nb) < -AGAINST_COS
+    up_p = dp[1] / float(np.hypot(*dp))
+    up_b = db[1] / nb
+    return abs(up_p) > 0.5 and abs(up_b) > 0.5 and up_p * up_b < 0
+
+
+def extend_path(surface: Surface, path: np.ndarray, before_m: float, after_m: float) -> np.ndarray:
+    """A surface path (k, 3) continued straight along its end directions by `before_m` and `after_m` metres and
+    put back on the surface (every PATH_STEP_M)."""
+    if before_m <= 0 and after_m <= 0:
+        return path
+    parts = [path]
+    for amount, end, prev, at_start in ((before_m, 0, 1, True), (after_m, -1, -2, False)):
+        if amount <= 0:
+            continue
+        d = path[end] - path[prev]
+        d /= max(float(np.linalg.norm(d)), 1e-300)
+        steps = np.arange(1, int(np.ceil(amount / PATH_STEP_M)) + 1) * (amount / np.ceil(amount / PATH_STEP_M))
+        ext = surface.closest(path[end] + steps[:, None] * d).points
+        parts = [ext[::-1], *parts] if at_start else [*parts, ext]
+    return np.vstack(parts)
+
+
 def place_strokes(
     pm: PatternMesh,
     welded: Welded,
@@ -137,8 +192,11 @@ def place_strokes(
     collider: BodyCollider,
     *,
     lift_m: float,
+    placements: dict[str, PiecePlacement] | None = None,
 ) -> Placement:
-    """Lay the triangles crossed by each pattern stroke onto the body along its (resolved) body stroke."""
+    """Lay the triangles crossed by each pattern stroke onto the body along its (resolved) body stroke.
+
+    placements : the pattern's piece placements by piece name (to tell which way a stroke runs), if any."""
     nv = welded.n_vertices
     acc = np.zeros((nv, 3))
     cnt = np.zeros(nv)
@@ -160,6 +218,9 @@ def place_strokes(
         side = 1.0 if d1[0] * d2[1] - d1[1] * d2[0] > 0 else -1.0
 
         bpath, lb = body_path(surface, pair, path)
+        flip = stroke_reversed(ps.points, bpath, (placements or {}).get(ps.piece))
+        if flip:
+            bpath = np.ascontiguousarray(bpath[::-1])
         lp = ps.length_cm
 
         vids = np.unique(pm.faces[crossed])
@@ -171,7 +232,9 @@ def place_strokes(
 
         samples = resample_polyline(ps.points, RESIDUAL_SAMPLES)
         pf, bary = _locate(pm, crossed, samples)
-        tracks.append(StrokeTrack(pair.id, garment_face_of[pf], bary, bpath, lp / 100.0, lb))
+        over = max(0.0, 0.5 * (lp / 100.0 - lb))
+        held = extend_path(surface, bpath, over, over)
+        tracks.append(StrokeTrack(pair.id, garment_face_of[pf], bary, held, lp / 100.0, lb, flip))
     placed = cnt > 0
     pos = np.zeros((nv, 3))
     pos[placed] = acc[placed] / cnt[placed, None]
@@ -199,15 +262,21 @@ def lay_along(
     collider: BodyCollider,
     *,
     lift_m: float,
+    fit_length: bool = False,
 ) -> np.ndarray:
     """Positions (n, 3) metres on the body of pattern points (n, 2) cm near the pattern stroke `ps`: arc length
-    along the stroke mapped onto the body path `bpath` (k, 3), the offset across it laid out on the surface
-    (`side` = the piece's orientation sign), `lift_m` off the surface."""
+    along the stroke laid along the body path `bpath` (k, 3) at its own length, the middles together (module
+    docstring), the offset across it laid out on the surface (`side` = the piece's orientation sign), `lift_m`
+    off the surface. fit_length : stretch the pattern stroke to the whole body path instead (the paper's
+    arc-length correspondence; the re-wrap's, whose strokes are drawn on the garment itself)."""
     lb = float(arc_length(bpath)[-1])
     lp = ps.length_cm
     s, off = _extended_coordinates(points_cm, np.asarray(ps.points, dtype=np.float64))
-    t = s / lp
-    inside = np.clip(t, 0.0, 1.0) * lb
+    if fit_length:
+        along = s / lp * lb
+    else:
+        along = s / 100.0 + 0.5 * (lb - lp / 100.0)  # metres along the body path
+    inside = np.clip(along, 0.0, lb)
     q = interpolate_polyline(bpath, inside)
     eps = min(0.01, 0.25 * lb)
     tangent = interpolate_polyline(bpath, inside + eps) - interpolate_polyline(bpath, inside - eps)
@@ -216,9 +285,9 @@ def lay_along(
     tangent -= np.einsum("ij,ij->i", tangent, normal)[:, None] * normal
     tangent /= np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-300)
     across = side * np.cross(normal, tangent)
-    # Beyond its ends the stroke is continued straight along its end tangent (metres of body per metre of
-    # pattern: lb / lp), so the crossed triangles that stick out past an end keep their shape.
-    beyond = (t - np.clip(t, 0.0, 1.0)) * lb
+    # Beyond its ends the body stroke is continued straight along its end tangent, so the crossed triangles that
+    # stick out past an end keep their shape.
+    beyond = along - inside
     x = on.points + beyond[:, None] * tangent + (off / 100.0)[:, None] * across
     proj = surface.closest(x)
     nx = smooth_normals(collider, proj.faces, proj.barycentric)

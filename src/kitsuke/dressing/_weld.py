@@ -139,22 +139,50 @@ def _split_edges(pm: PatternMesh, split: np.ndarray) -> PatternMesh:
     )
 
 
-def repair_corners(pm: PatternMesh) -> PatternMesh:
+def _where(pm: PatternMesh, merged: np.ndarray, seams: list | None) -> str:
+    """Where sewing leaves a garment edge on more than two triangles: the seams whose vertices it joins (named
+    from `seams`, the pattern's Seam list, when given) and a pattern point of it."""
+    f = merged[pm.faces]
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    key, count = np.unique(e[:, 0] * len(merged) + e[:, 1], return_counts=True)
+    hot = key[count > 2]
+    if not len(hot):
+        return ""
+    ends = {int(hot[0] // len(merged)), int(hot[0] % len(merged))}
+    at = np.flatnonzero(np.isin(merged, list(ends)))
+    involved = [i for i, sv in enumerate(pm.seam_vertices) if np.isin(np.asarray(sv).reshape(-1), at).any()]
+    piece = pm.piece_names[int(pm.vertex_piece[at[0]])]
+    x, y = pm.vertices_cm[at[0]]
+    if seams is not None:
+        names = [
+            f"seam {i} ({seams[i].a.piece} edge {seams[i].a.edge} - {seams[i].b.piece} edge {seams[i].b.edge})"
+            for i in involved
+        ]
+    else:
+        names = [f"seam {i}" for i in involved]
+    return f" at ({x:.1f}, {y:.1f}) cm on piece {piece}" + (f", where {', '.join(names)} meet" if names else "")
+
+
+def repair_corners(pm: PatternMesh, seams: list | None = None) -> PatternMesh:
     """`pm` itself if sewing its seams gives a manifold garment, else a copy with the inner edges of coinciding
     corner triangles split (see the module docstring). Raises InputError where more than two pattern edges are
-    sewn together (three pieces on one seam), which no split repairs."""
+    sewn together (three pieces on one seam), which no split repairs, naming the place and the seams (from
+    `seams`, the pattern's Seam list, when given)."""
     for _ in range(REPAIR_ROUNDS):
         merged = _sewn(pm)
         split, hopeless = _bad_edges(pm, merged)
         if hopeless:
             raise InputError(
-                f"pattern {pm.name!r}: {hopeless} seam edge(s) join more than two pieces' edges; "
-                "a seam joins exactly two edges"
+                f"pattern {pm.name!r}: {hopeless} seam edge(s) join more than two pieces' edges"
+                f"{_where(pm, merged, seams)}; a seam joins exactly two edges"
             )
         if not len(split):
             return pm
         pm = _split_edges(pm, split)
-    raise InputError(f"pattern {pm.name!r}: sewing its seams leaves edges shared by more than two triangles")
+    raise InputError(
+        f"pattern {pm.name!r}: sewing its seams leaves edges shared by more than two triangles"
+        f"{_where(pm, _sewn(pm), seams)}"
+    )
 
 
 def weld(pm: PatternMesh) -> Welded:
@@ -187,3 +215,13 @@ def weld(pm: PatternMesh) -> Welded:
         piece_faces=np.asarray(pm.piece_faces, dtype=np.int64).copy(),
         n_vertices=n,
     )
+
+
+def check_sewable(pattern, *, edge_length_cm: float = 1.5) -> PatternMesh:
+    """Mesh `pattern` (a kitsuke Pattern) and sew it as the wrap would; the repaired PatternMesh, or InputError
+    naming the seam and the place that cannot be sewn (what `kitsuke pattern validate` reports for `dress`)."""
+    from ..pattern import mesh_pattern
+
+    pm = repair_corners(mesh_pattern(pattern, edge_length=edge_length_cm), pattern.seams)
+    weld(pm)
+    return pm

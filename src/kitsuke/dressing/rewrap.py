@@ -240,7 +240,7 @@ def rewrap(
         corners_uv = tri[crossed].reshape(-1, 2)
         vids, first = np.unique(corners_v, return_index=True)
         bpath, _ = body_path(body_surface, pair, src)
-        x = lay_along(corners_uv[first], ps, side, bpath, body_surface, collider, lift_m=p.lift_m)
+        x = lay_along(corners_uv[first], ps, side, bpath, body_surface, collider, lift_m=p.lift_m, fit_length=True)
         np.add.at(acc, vids, x)
         np.add.at(cnt, vids, 1.0)
         samples = resample_polyline(ps.points, RESIDUAL_SAMPLES)

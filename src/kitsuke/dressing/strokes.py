@@ -391,13 +391,38 @@ def triangles_crossed(pattern_mesh: PatternMesh, stroke: PatternStroke) -> np.nd
     return np.unique(faces) + f0
 
 
+def in_piece_frame(strokes: Strokes, pattern: Pattern) -> Strokes:
+    """`strokes` with every pattern stroke moved from the coordinates of the pattern's file (what a user draws
+    on: GarmentCode's own panel coordinates) to the piece's own (`Pattern.file_to_piece`); the same object when
+    no piece differs."""
+    if not any(p.pattern.piece in pattern.file_mirrored for p in strokes.pairs):
+        return strokes
+    pairs = [
+        dataclasses.replace(
+            p, pattern=PatternStroke(p.pattern.piece, pattern.file_to_piece(p.pattern.piece, p.pattern.points))
+        )
+        for p in strokes.pairs
+    ]
+    return Strokes(pairs, strokes.target, dict(strokes.meta), strokes.source)
+
+
+def in_file_frame(strokes: Strokes, pattern: Pattern) -> Strokes:
+    """The inverse of `in_piece_frame`: strokes as a user would write them for the pattern's file."""
+    return in_piece_frame(strokes, pattern)  # a mirror is its own inverse
+
+
 def check_strokes(strokes: Strokes, pattern: Pattern, *, pattern_mesh: PatternMesh | None = None) -> None:
     """Check the pattern side of every stroke; InputError naming the strokes file and the stroke id.
 
-    Each pattern stroke must name a piece of `pattern`; its points, and its path sampled every 0.5 cm, must
-    lie on the piece (curved edges included) to within 1 mm; given `pattern_mesh`, it must cross at least one
-    triangle of its piece there.
+    Pattern points are in the coordinates of the pattern's file (`in_piece_frame`). Each pattern stroke must
+    name a piece of `pattern`; its points, and its path sampled every 0.5 cm, must lie on the piece (curved
+    edges included) to within 1 mm; given `pattern_mesh`, it must cross at least one triangle of its piece there.
     """
+    _check_on_pieces(in_piece_frame(strokes, pattern), pattern, pattern_mesh)
+
+
+def _check_on_pieces(strokes: Strokes, pattern: Pattern, pattern_mesh: PatternMesh | None) -> None:
+    """`check_strokes` for strokes already in the pieces' own coordinates."""
     path = strokes.source or None
     polygons: dict[str, np.ndarray] = {}
     for pair in strokes.pairs:
@@ -447,9 +472,11 @@ def resolve_strokes(
         reuses its acceleration structures across calls.
     Drawn points go to their closest surface point (libigl AABB) and must lie within `max_distance_m` of it;
     laser rays take their first or last hit (embree) and must hit. Returns a new Strokes whose body strokes
-    have `surface` filled in; raises InputError naming the strokes file and the stroke id.
+    have `surface` filled in and whose pattern strokes are in the pieces' own coordinates (`in_piece_frame`);
+    raises InputError naming the strokes file and the stroke id.
     """
-    check_strokes(strokes, pattern, pattern_mesh=pattern_mesh)
+    strokes = in_piece_frame(strokes, pattern)
+    _check_on_pieces(strokes, pattern, pattern_mesh)
     return strokes_on_surface(strokes, surface, max_distance_m=max_distance_m)
 
 

@@ -66,7 +66,7 @@ from ..cloth import (
     restore_lengths,
     untangle,
 )
-from ..errors import InputError
+from ..errors import ComputationError, InputError
 from ..geometry import TriMesh
 from ..metrics import QualityReport, quality_report, strain
 from ..pattern import Pattern, PatternMesh, face_layers, mesh_pattern
@@ -77,6 +77,7 @@ from ._polish_step import PolishSettings, polish_step
 from ._refined import pieces_contiguous, remap_track, reorder_state
 from ._solve import GlobalRelax, gravity_settle
 from ._weld import repair_corners, weld
+from .outcome import on_body_failures, target_misses
 from .strokes import Strokes, resolve_strokes
 
 
@@ -165,6 +166,9 @@ class WrapParams:
         strain without -> with, the last untangle at bend 0.3): shirt 20.6 -> 8.6 mm, 0.81 -> 0.94 %; hoody
         22.2 -> 8.4 mm, 0.94 -> 0.98 %; T-shirt 14.9 -> 8.2 mm, 0.46 -> 0.55 %; kimono 19.6 -> 8.8 mm, 0.89 ->
         0.95 %. None: no pull.
+    tether_slack_m : metres. A stroke whose cloth the settle left farther than this from its body stroke is not
+        tethered (`stroke_reach_m`): the pattern cannot lie there without stretching, and pulling it back tears the
+        cloth; its residual is reported (`DressedGarment.loose_strokes`). The shipped cases settle 15-22 mm away.
     untangle_bend : hinge stiffness of the last untangle (`kitsuke.cloth.untangle`'s bend_stiffness; the one
         after the close keeps its 0.3). The folds left after the length restoration are where the sweeps laid
         spare cloth flat; a stiff hinge opens them into strained cloth. Mean / max strain at 0.3 -> 0.1: shirt
@@ -237,6 +241,7 @@ class WrapParams:
     length_collide_every: int = 4
     stroke_reach_m: float | None = 0.008
     untangle_bend: float = 0.1
+    tether_slack_m: float = 0.03
     tear_strain: float | None = 1.0
     mend_rounds: int = 3
     untangle_rounds: int = 10
@@ -286,13 +291,15 @@ class WrapParams:
                 raise InputError(f"wrap parameter {name} must be >= 0")
         if not (
             self.edge_length_cm > 0
+            and self.tether_slack_m > 0
             and self.lift_m >= 0
             and self.close_tolerance_m >= 0
             and self.stroke_hold >= 0
             and self.contact_weight >= 0
         ):
             raise InputError(
-                "wrap parameters edge_length_cm > 0, lift_m >= 0, close_tolerance_m >= 0, stroke_hold >= 0, "
+                "wrap parameters edge_length_cm > 0, tether_slack_m > 0, lift_m >= 0, close_tolerance_m >= 0, "
+                "stroke_hold >= 0, "
                 "contact_weight >= 0 required"
             )
         if self.settle not in ("jacobi", "global"):
@@ -340,7 +347,8 @@ class DressedGarment:
     model : the ClothModel (rest shape, rest lengths); pinned : (V,) bool, vertices held at the end (hold band).
     stroke_ids : stroke ids in drawing order. stroke_residual_m : (S,) float64 metres, for each stroke the largest
         distance of its pattern stroke (on the garment) to its body stroke after the settle.
-    stroke_length_ratio : (S,) body stroke length / pattern stroke length (1 = the stroke asks for no stretch).
+    stroke_length_ratio : (S,) body stroke length / pattern stroke length (the cloth keeps its own length).
+    loose_strokes : ids of the strokes not held to their body strokes after the settle (`tether_slack_m`).
     rings : growth rings. mend : what `_mend.mend_tears` did after the close (rounds, torn edges before and
         after). polished : the polish's result was kept (`WrapParams.polish_rounds`). timings : seconds per step
         ("mesh", "resolve", "place", "grow", "close", "settle", "finish", "untangle", "polish", "wrap" = all of
@@ -362,6 +370,7 @@ class DressedGarment:
     stroke_residual_m: np.ndarray = field(default_factory=lambda: np.zeros(0))
     stroke_length_ratio: np.ndarray = field(default_factory=lambda: np.zeros(0))
     tracks: list[StrokeTrack] = field(default_factory=list, repr=False)
+    loose_strokes: list[int] = field(default_factory=list)
     rings: int = 0
     mend: MendStats = field(default_factory=MendStats)
     polished: bool = False
@@ -390,12 +399,25 @@ class DressedGarment:
             "held_vertices": int(self.pinned.sum()),
             "mend": dataclasses.asdict(self.mend),
             "polished": self.polished,
+            "loose_strokes": list(self.loose_strokes),
             "timings_s": {k: round(v, 4) for k, v in self.timings.items()},
             "strokes": [
-                {"id": i, "residual_mm": round(float(r) * 1e3, 2), "length_ratio": round(float(q), 4)}
-                for i, r, q in zip(self.stroke_ids, self.stroke_residual_m, self.stroke_length_ratio, strict=True)
+                {
+                    "id": i,
+                    "residual_mm": round(float(r) * 1e3, 2),
+                    "length_ratio": round(float(q), 4),
+                    "reversed": bool(tr.reversed) if tr is not None else False,
+                }
+                for i, r, q, tr in zip(
+                    self.stroke_ids,
+                    self.stroke_residual_m,
+                    self.stroke_length_ratio,
+                    self.tracks or [None] * len(self.stroke_ids),
+                    strict=True,
+                )
             ],
             "quality": None if self.report is None else self.report.to_dict(),
+            "targets_missed": None if self.report is None else target_misses(self),
         }
 
 
@@ -445,6 +467,7 @@ def wrap(
     params: WrapParams | None = None,
     collider: BodyCollider | None = None,
     report: bool = True,
+    check: bool = True,
 ) -> DressedGarment:
     """Dress `body` with `garment` placed by `strokes` (SPEC §4.2); see the module docstring for the steps.
 
@@ -455,6 +478,9 @@ def wrap(
     collider : a prepared BodyCollider for `body` (built if None); its Surface (one AABB tree, ~50 ms to build on
         mean_all) also places and resolves the strokes, so pass the same collider to repeated wraps.
     report : compute the quality report (a winding-number test; not part of the wrap's time).
+    check : raise ComputationError (with the garment as its `result`) when the result is not a garment on the
+        body (`kitsuke.dressing.on_body_failures`: non-finite, a piece off the body, torn cloth, a stroke far from
+        where it was drawn); a stage that goes non-finite raises it whatever `check` says.
     Raises InputError for strokes naming a missing piece or crossing no triangle, a body with holes, and a
     garment that the strokes cannot reach (a piece joined by no seam to any piece with a stroke).
     """
@@ -477,7 +503,7 @@ def wrap(
     else:
         raise InputError("garment must be a Pattern or a PatternMesh")
     # Corners where two seams of one piece meet would sew into coinciding triangles: split them (usually a no-op).
-    pm = repair_corners(pm)
+    pm = repair_corners(pm, None if pattern is None else pattern.seams)
     mesh = body if isinstance(body, TriMesh) else body.mesh
     t1 = time.perf_counter()
     timings["mesh"] = t1 - t0
@@ -499,7 +525,8 @@ def wrap(
     timings["resolve"] = t2 - t1
 
     welded = weld(pm)
-    placement = place_strokes(pm, welded, strokes, surface, collider, lift_m=p.lift_m)
+    placements = None if pattern is None else {pc.name: pc.placement for pc in pattern.pieces if pc.placement}
+    placement = place_strokes(pm, welded, strokes, surface, collider, lift_m=p.lift_m, placements=placements)
     grow_params = dataclasses.replace(p.cloth, gravity_step_m=0.0)
     layer = face_layers(pm.layers, pm.piece_names, welded.piece_faces, welded.rest_corners * 100.0)
     model = ClothModel.from_corners(
@@ -532,6 +559,7 @@ def wrap(
             f"no stroke reaches piece(s) {', '.join(names)}: draw a stroke on them or sew them to a piece that has one",
             strokes.source or None,
         )
+    _finite(state, "grow")
     t4 = time.perf_counter()
     timings["grow"] = t4 - t3
 
@@ -572,6 +600,7 @@ def wrap(
             )
     if p.untangle_rounds:  # before the hold band is pinned: a fold inside the band could not open later
         untangle(model, state, collider, rounds=p.untangle_rounds)
+    _finite(state, "close")
     t5 = time.perf_counter()
     timings["close"] = t5 - t4
 
@@ -595,6 +624,7 @@ def wrap(
             stick_weight=p.stick_weight,
             contact_weight=p.contact_weight,
         )
+    _finite(state, "settle")
     t_settled = time.perf_counter()
     timings["settle"] = t_settled - t5
     # The band holds the cloth up against gravity; the finish and the length restoration have none, so they let
@@ -602,9 +632,16 @@ def wrap(
     # 1.22 % held, 0.95 % let go).
     unheld = pins & ~band
     tethers = None
-    if p.stroke_reach_m is not None:
+    # A stroke whose cloth settled far from it is not pulled back: where the pattern cannot lie along the stroke
+    # without stretching, the pull tears it (a crop top on suggested strokes that slid 8 cm in the close: 44 ->
+    # 249 % max strain with its tethers, 19 % without). Its residual is reported instead.
+    settled = np.array([tr.residual_m(state.positions, model.faces) for tr in placement.tracks])
+    loose = settled > p.tether_slack_m
+    if p.stroke_reach_m is not None and not loose.all():
         tethers = Tethers.from_polylines(
-            [(tr.faces, tr.bary, tr.body_path) for tr in placement.tracks], model.faces, p.stroke_reach_m
+            [(tr.faces, tr.bary, tr.body_path) for tr, far in zip(placement.tracks, loose, strict=True) if not far],
+            model.faces,
+            p.stroke_reach_m,
         )
     if p.finish_iterations:
         finish = GlobalRelax(model, unheld, contact_weight=p.contact_weight)
@@ -628,6 +665,7 @@ def wrap(
             collide_every=p.length_collide_every,
         )
         state.pinned = pins
+    _finite(state, "length restoration")
     t_finished = time.perf_counter()
     timings["finish"] = t_finished - t_settled
     if p.untangle_rounds:
@@ -707,8 +745,11 @@ def wrap(
             out_model, piece_faces, corner_uv = ordered.model, ordered.piece_faces, ordered.corner_uv
             if tethers is not None:  # a later pass holds the strokes on the refined faces
                 tethers = Tethers.from_polylines(
-                    [(tr.faces, tr.bary, tr.body_path) for tr in tracks], out_model.faces, p.stroke_reach_m
+                    [(tr.faces, tr.bary, tr.body_path) for tr, far in zip(tracks, loose, strict=True) if not far],
+                    out_model.faces,
+                    p.stroke_reach_m,
                 )
+    _finite(state, "polish")
     t6 = time.perf_counter()
     timings["polish"] = t6 - t_untangled
     timings["wrap"] = t6 - t0
@@ -730,6 +771,7 @@ def wrap(
         stroke_residual_m=residual,
         stroke_length_ratio=ratio,
         tracks=tracks,
+        loose_strokes=[tr.id for tr, far in zip(placement.tracks, loose, strict=True) if far],
         rings=rings,
         polished=polished,
         mend=mended,
@@ -745,4 +787,16 @@ def wrap(
             pieces=(result.piece_names, result.piece_faces),
         )
         timings["report"] = time.perf_counter() - t6
+    if check:
+        bad = on_body_failures(result, body, surface=surface)
+        if bad:
+            more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
+            raise ComputationError("wrap", f"not a garment on the body: {bad[0]}{more}", result=result)
     return result
+
+
+def _finite(state: ClothState, stage: str) -> None:
+    """Raise ComputationError naming the wrap stage after which a position is no longer finite."""
+    if not np.isfinite(state.positions).all():
+        n = int((~np.isfinite(state.positions).all(axis=1)).sum())
+        raise ComputationError(f"wrap: {stage}", f"{n} cloth positions became non-finite")

@@ -329,12 +329,28 @@ class Pattern:
     seams : list of Seam.
     meta : free-form JSON-serialisable information (where it came from, generator parameters, edge names);
         kept through kitsuke JSON files.
+    file_mirrored : names of the pieces whose coordinates in the file the pattern was read from are mirrored
+        (x -> -x) against the piece's own: a GarmentCode back panel, which runs clockwise there. Strokes are
+        drawn in the file's coordinates (`file_to_piece`); a kitsuke JSON file written from this pattern holds
+        the piece's own coordinates, so this is not saved.
     """
 
     name: str
     pieces: list[Piece] = field(default_factory=list)
     seams: list[Seam] = field(default_factory=list)
     meta: dict[str, Any] = field(default_factory=dict)
+    file_mirrored: frozenset[str] = field(default_factory=frozenset, compare=False)
+
+    def file_to_piece(self, piece: str, points: np.ndarray) -> np.ndarray:
+        """Points (n, 2) cm in the coordinates of the file the pattern came from -> the piece's own (a copy)."""
+        pts = np.array(points, dtype=np.float64)
+        if piece in self.file_mirrored:
+            pts[..., 0] *= -1.0
+        return pts
+
+    def piece_to_file(self, piece: str, points: np.ndarray) -> np.ndarray:
+        """The inverse of `file_to_piece` (the mirror is its own inverse)."""
+        return self.file_to_piece(piece, points)
 
     @property
     def piece_names(self) -> list[str]:

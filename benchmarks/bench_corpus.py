@@ -1,0 +1,196 @@
+"""Robustness of the wrap on garments nobody tuned for: random GarmentCode designs, suggested strokes perturbed
+as a hand would draw them, dressed on GarmentCode's mean_all body.
+
+    python benchmarks/bench_corpus.py --seeds 11 12 --n 12 [--no-perturb] [--drag] [--json out.json]
+
+For each seed, `../shared/tools/garment_sampler/sample.py` draws `--n` designs (only those whose outlines do not
+cross); each design's strokes come from `kitsuke.dressing.suggest_strokes` and are then perturbed
+(`kitsuke.dressing.perturb_strokes`: length x0.7-1.3, moved up to 2 cm, drawn backwards half the time, one
+stroke left out). Each is dressed with `wrap` and sorted into:
+
+- within targets: `kitsuke.metrics.QualityTargets.robust()` (nothing deeper than 2 mm inside, mean strain <= 1 %, max
+  strain <= 10 %, seams closed, no inverted triangle, every stroke within 1 cm of where it was drawn);
+- written out of target: a garment on the body that misses one of them (what `kitsuke dress` writes, exit 0);
+- refused: bad input (`InputError`: what `kitsuke dress` refuses with exit 2), with the reason;
+- failed: `ComputationError` (exit 1, nothing written), with the stage;
+- garbage: written as a garment (no error) yet not on the body by `kitsuke.dressing.on_body_failures`; this
+  must stay 0.
+
+It prints a table per design and the shares, the median and worst time, and with `--drag` a 5 cm lift of each
+dressed garment by a point on its front (`DragSession`), released, beside the wrap.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+import time
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLER = ROOT.parent / "shared" / "tools" / "garment_sampler" / "sample.py"
+BODY = ROOT / "tests" / "data" / "bodies" / "mean_all.obj"
+
+
+def sample(seed: int, n: int, out: Path) -> list[Path]:
+    """GarmentCode designs (specification files) drawn by the sampler with `seed`."""
+    out.mkdir(parents=True, exist_ok=True)
+    subprocess.run(
+        [sys.executable, str(SAMPLER), str(out), "--n", str(n), "--seed", str(seed)],
+        check=True,
+        capture_output=True,
+    )
+    return sorted(out.glob("*_specification.json"))
+
+
+def dress_one(path: Path, body, collider, surface, rng, perturb: bool, drag: bool, params=None) -> dict:
+    from kitsuke.dressing import on_body_failures, perturb_strokes, suggest_strokes, target_misses, wrap
+    from kitsuke.errors import ComputationError, InputError
+    from kitsuke.metrics import QualityTargets
+    from kitsuke.pattern import load_pattern
+
+    row: dict = {"design": path.stem.replace("_specification", "")}
+    t0 = time.perf_counter()
+    try:
+        pattern = load_pattern(path)
+        row["pieces"] = len(pattern.pieces)
+        strokes = suggest_strokes(body, pattern, surface=surface)
+        if perturb:
+            strokes = perturb_strokes(strokes, surface, rng)
+        row["strokes"] = len(strokes)
+        garment = wrap(body, pattern, strokes, collider=collider, params=params)
+    except InputError as e:
+        row.update(status="refused", reason=str(e).split(": ", 1)[-1][:160], seconds=time.perf_counter() - t0)
+        return row
+    except ComputationError as e:
+        row.update(status="failed", reason=str(e)[:160], seconds=time.perf_counter() - t0)
+        return row
+    row["seconds"] = time.perf_counter() - t0
+    r = garment.report
+    row.update(
+        strain_mean=r.strain_mean,
+        strain_max=r.strain_max,
+        deepest_mm=r.penetration_deepest_mm,
+        seam_gap_mm=r.seam_gap_mm,
+        inverted=r.inverted_count,
+        stroke_mm=garment.max_stroke_residual_m * 1e3,
+    )
+    bad = insane(garment, surface) + on_body_failures(garment, body, surface=surface)
+    misses = target_misses(garment, QualityTargets.robust())
+    row["status"] = "garbage" if bad else ("ok" if not misses else "out of target")
+    row["reason"] = "; ".join(bad or misses)[:200]
+    if drag and not bad:
+        row.update(drag_lift(garment, body))
+    return row
+
+
+def insane(garment, surface) -> list[str]:
+    """A check independent of the wrap's own: a written garment must be finite, within 0.6 m of the body
+    everywhere and nowhere stretched to three times its length."""
+    p = garment.positions
+    if not np.isfinite(p).all():
+        return ["non-finite"]
+    out = []
+    far = surface.closest(p).distance.max()
+    if far > 0.6:
+        out.append(f"a vertex {far:.2f} m from the body")
+    if garment.report.strain_max > 2.0:
+        out.append(f"strain {100 * garment.report.strain_max:.0f} %")
+    return out
+
+
+def drag_lift(garment, body) -> dict:
+    """Grab the garment's vertex nearest the body's front at chest height, lift it 5 cm, release."""
+    from kitsuke.dressing import DragSession
+    from kitsuke.errors import ComputationError
+
+    p = garment.positions
+    front = int(np.argmax(p[:, 2] - 2.0 * np.abs(p[:, 0]) - 2.0 * np.abs(p[:, 1] - np.median(p[:, 1]))))
+    t0 = time.perf_counter()
+    try:
+        s = DragSession(body, garment)
+        s.grab(p[front])
+        s.move_by([0.0, 0.05, 0.0])
+        s.release()
+        r = s.garment().report
+    except ComputationError as e:
+        return {"drag": "failed", "drag_reason": str(e)[:120], "drag_seconds": time.perf_counter() - t0}
+    return {
+        "drag": "ok"
+        if r.strain_max <= 0.10 and r.strain_mean <= 0.01 and r.penetration_count == 0
+        else "out of target",
+        "drag_strain_max": r.strain_max,
+        "drag_seconds": time.perf_counter() - t0,
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--seeds", type=int, nargs="+", default=[11, 12])
+    ap.add_argument("--n", type=int, default=12, help="designs sampled per seed")
+    ap.add_argument("--no-perturb", action="store_true", help="dress with the suggested strokes as they are")
+    ap.add_argument("--drag", action="store_true", help="also lift each dressed garment 5 cm and release it")
+    ap.add_argument("--json", help="write the rows here")
+    ap.add_argument("--keep", help="keep the sampled designs in this folder (reused when already there)")
+    ap.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE", help="WrapParams to change (Python values)")
+    ap.add_argument("--only", nargs="*", default=None, help="dress only designs whose name contains one of these")
+    args = ap.parse_args()
+    if not SAMPLER.exists():
+        sys.exit(f"bench_corpus needs GarmentCode's sampler at {SAMPLER}")
+
+    import ast
+
+    from kitsuke.body import load_body
+    from kitsuke.cloth import BodyCollider
+    from kitsuke.dressing import WrapParams
+
+    changes = {k: ast.literal_eval(v) for k, v in (a.split("=", 1) for a in args.set)}
+    params = WrapParams(**changes)
+
+    body = load_body(BODY)
+    collider = BodyCollider.from_body(body)
+    surface = collider.surface_for(body.mesh)
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        base = Path(args.keep) if args.keep else Path(tmp)
+        for seed in args.seeds:
+            folder = base / f"seed{seed}"
+            paths = sorted(folder.glob("*_specification.json")) or sample(seed, args.n, folder)
+            for path in paths:
+                if args.only and not any(o in path.stem for o in args.only):
+                    continue
+                rng = np.random.default_rng(zlib.crc32(path.stem.encode()))
+                row = dress_one(path, body, collider, surface, rng, not args.no_perturb, args.drag, params)
+                row["seed"] = seed
+                rows.append(row)
+                print(
+                    f"{row['design']:16s} {row['status']:13s} {row.get('seconds', 0):6.1f} s  "
+                    f"mean {100 * row.get('strain_mean', np.nan):5.2f} %  "
+                    f"max {100 * row.get('strain_max', np.nan):6.1f} %"
+                    f"  deep {row.get('deepest_mm', np.nan):5.1f} mm  stroke {row.get('stroke_mm', np.nan):5.1f} mm"
+                    f"  {row.get('drag', '')} {row.get('reason', '')}",
+                    flush=True,
+                )
+    n = len(rows)
+    count = {k: sum(r["status"] == k for r in rows) for k in ("ok", "out of target", "refused", "failed", "garbage")}
+    times = [r["seconds"] for r in rows if "seconds" in r]
+    print(f"\n{n} designs, seeds {args.seeds}, {'perturbed' if not args.no_perturb else 'suggested'} strokes")
+    for k, v in count.items():
+        print(f"  {k:14s} {v:3d}  {100 * v / max(n, 1):5.1f} %")
+    if times:
+        print(f"  time: median {np.median(times):.1f} s, worst {max(times):.1f} s")
+    if args.drag:
+        dr = [r for r in rows if "drag" in r]
+        print(f"  drag: {sum(r['drag'] == 'ok' for r in dr)} of {len(dr)} lifts within targets after release")
+    if args.json:
+        Path(args.json).write_text(json.dumps(rows, indent=1, default=float))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,109 @@
+"""Is a dressed garment a garment on the body, and does it meet its targets? The honest outcome of a wrap.
+
+Two different questions, with two different answers for a user:
+
+- `on_body_failures(garment, body)`: what makes the result *not a garment on the body* — non-finite positions, a
+  piece that lies far off the body, cloth torn (edges stretched to more than twice their length), a stroke
+  whose cloth ended far from where it was drawn. Any of these and `wrap` raises `ComputationError` (the CLI:
+  exit 1, nothing written as if it worked; `--keep-failed` writes it as `*.failed.*`).
+- `target_misses(garment, targets)`: the quality targets a garment on the body misses (SPEC §6 plus stroke
+  adherence); it is written, and the misses are said on stderr and in the report.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..geometry import TriMesh
+from ..geometry.surface import Surface
+from ..metrics import QualityTargets
+
+#: A piece whose nearest vertex lies farther than this from the body is off the body, metres.
+OFF_BODY_M = 0.10
+#: An edge longer than (1 + this) times its rest length is torn.
+TORN_STRAIN = 1.0
+#: A stroke whose cloth lies farther than this from its body stroke has left where it was drawn, metres.
+STROKE_LOST_M = 0.05
+
+
+def _piece_of_vertex(garment) -> np.ndarray:
+    """(V,) int64: a piece of each garment vertex (the first piece whose face uses it; -1 for none)."""
+    piece = np.full(len(garment.positions), -1, dtype=np.int64)
+    for k in range(len(garment.piece_names) - 1, -1, -1):
+        a, b = garment.piece_faces[k]
+        piece[garment.faces[a:b].reshape(-1)] = k
+    return piece
+
+
+def on_body_failures(garment, body, *, surface: Surface | None = None) -> list[str]:
+    """Why `garment` (a DressedGarment) is not a garment on `body` (Body or TriMesh), one line each, naming the
+    piece or stroke; empty when it is one."""
+    pos = garment.positions
+    if not np.isfinite(pos).all():
+        bad = ~np.isfinite(pos).all(axis=1)
+        names = sorted({garment.piece_names[k] for k in _piece_of_vertex(garment)[bad] if k >= 0})
+        return [f"non-finite positions on piece(s) {', '.join(names) or '?'}"]
+    out = []
+    mesh = body if isinstance(body, TriMesh) else body.mesh
+    surf = surface if surface is not None else Surface(mesh)
+    dist = surf.closest(pos).distance
+    piece = _piece_of_vertex(garment)
+    for k, name in enumerate(garment.piece_names):
+        d = dist[piece == k]
+        if len(d) and d.min() > OFF_BODY_M:
+            out.append(f"piece {name} lies {100 * d.min():.0f} cm off the body")
+    m = garment.model
+    e = m.edges
+    length = np.linalg.norm(pos[e[:, 0]] - pos[e[:, 1]], axis=1)
+    ratio = length / np.maximum(m.rest_lengths, 1e-12)
+    worst = int(np.argmax(ratio)) if len(ratio) else -1
+    if worst >= 0 and ratio[worst] > 1.0 + TORN_STRAIN:
+        k = piece[e[worst, 0]]
+        out.append(
+            f"piece {garment.piece_names[k] if k >= 0 else '?'} is torn: an edge at {ratio[worst]:.1f}x its length"
+            f" at ({', '.join(f'{c:.2f}' for c in pos[e[worst, 0]])}) m"
+        )
+    for sid, r in zip(garment.stroke_ids, garment.stroke_residual_m, strict=True):
+        if not r <= STROKE_LOST_M:
+            out.append(f"stroke {sid}: its cloth ended {100 * r:.0f} cm from the body stroke")
+    return out
+
+
+def target_misses(garment, targets: QualityTargets | None = None) -> list[str]:
+    """The quality targets a garment on the body misses, one line each (empty: all met). The report's measures
+    are judged against `targets` (default: QualityTargets()), and the strokes against its stroke_residual_mm."""
+    t = targets or QualityTargets()
+    r = garment.report
+    out = []
+    if r is not None:
+        lines = {
+            "penetration": (
+                r.penetration_deepest_mm > t.penetration_mm,
+                f"{r.penetration_count} vertices deeper "
+                f"than {t.penetration_mm} mm inside the body (deepest {r.penetration_deepest_mm:.1f} mm)",
+            ),
+            "max_strain": (
+                r.strain_max > t.max_strain,
+                f"max edge strain {100 * r.strain_max:.1f} % > {100 * t.max_strain:.1f} %"
+                + ("" if r.strain_worst_at is None else f" (worst on {r.strain_worst_at})"),
+            ),
+            "mean_strain": (
+                r.strain_mean > t.mean_strain,
+                f"mean edge strain {100 * r.strain_mean:.2f} % > {100 * t.mean_strain:.2f} %",
+            ),
+            "seam_gap": (r.seam_gap_mm > t.seam_gap_mm, f"seam gap {r.seam_gap_mm:.1f} mm > {t.seam_gap_mm} mm"),
+            "inverted": (r.inverted_count > t.inverted, f"{r.inverted_count} inverted triangles > {t.inverted}"),
+        }
+        out += [line for missed, line in lines.values() if missed]
+    far = [
+        (sid, res)
+        for sid, res in zip(garment.stroke_ids, garment.stroke_residual_m, strict=True)
+        if res * 1e3 > t.stroke_residual_mm
+    ]
+    if far:
+        sid, res = max(far, key=lambda x: x[1])
+        out.append(
+            f"{len(far)} stroke(s) farther than {t.stroke_residual_mm:g} mm from where drawn "
+            f"(stroke {sid}: {res * 1e3:.0f} mm)"
+        )
+    return out

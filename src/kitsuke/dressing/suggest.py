@@ -1,0 +1,222 @@
+"""Suggested strokes: a stroke set proposed from the placement a pattern carries, for a user to start from.
+
+    from kitsuke.dressing import suggest_strokes
+    strokes = suggest_strokes(body, pattern)          # Strokes, pattern points in the pattern file's coordinates
+
+GarmentCode places every panel around its body, the kimono generator hangs its pieces as on a kimono stand. For
+each piece large enough to matter (`SuggestParams.min_area_share`; smaller ones, cuffs and waistbands, follow
+their seams), the pattern stroke runs along the piece's long axis through its middle, kept off its edges. Each of
+its points is carried to the body along the placed piece's normal (the body point nearest the placed point on
+that line, within `reach_m`), which keeps a sleeve's stroke on its arm where a nearest-point search would jump to
+the torso. The longest run of points that the body continues without a jump becomes the body stroke, and the
+longer of the two strokes is trimmed about its middle so that both have the same length.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from ..geometry.mesh import TriMesh
+from ..geometry.surface import Surface
+from ..pattern import Pattern, Piece
+from ._polyline import arc_length, interpolate_polyline, polygon_distance, polygon_inside
+from .strokes import BodyStroke, PatternStroke, StrokePair, Strokes
+
+#: Grid cells across a piece's bounding box when its area moments are sampled.
+MOMENT_GRID = 48
+
+
+@dataclass(frozen=True)
+class SuggestParams:
+    """Options of `suggest_strokes`.
+
+    min_area_share : a piece gets a stroke when its area is at least this share of the largest piece's.
+    margin_cm : the pattern stroke stays this far inside its piece's outline, cm.
+    trim : share of the inside chord left out at each end (strokes drawn by hand stop short of the edges).
+    step_cm : spacing of the stroke points, cm.
+    reach_m : a placed point is carried at most this far along the piece's normal to the body, metres.
+    jump_m : consecutive body points farther apart than this plus twice `step_cm` break the stroke (the line
+        ran off one limb onto another), metres.
+    min_length_cm : shorter strokes are not suggested, cm.
+    """
+
+    min_area_share: float = 0.15
+    margin_cm: float = 2.0
+    trim: float = 0.15
+    step_cm: float = 2.0
+    reach_m: float = 0.35
+    jump_m: float = 0.02
+    min_length_cm: float = 6.0
+
+    def __post_init__(self) -> None:
+        if not (
+            0 <= self.min_area_share <= 1
+            and self.margin_cm >= 0
+            and 0 <= self.trim < 0.5
+            and self.step_cm > 0
+            and self.reach_m > 0
+            and self.jump_m >= 0
+            and self.min_length_cm > 0
+        ):
+            raise InputError(
+                "suggest parameters: 0 <= min_area_share <= 1, margin_cm >= 0, 0 <= trim < 0.5, step_cm > 0, "
+                "reach_m > 0, jump_m >= 0, min_length_cm > 0 required"
+            )
+
+
+def long_axis_stroke(piece: Piece, params: SuggestParams) -> np.ndarray | None:
+    """(n, 2) cm: the piece's stroke along its long axis (principal axis of its area) through its centroid,
+    `margin_cm` inside the outline and trimmed by `trim` at each end; None when nothing of it is long enough."""
+    poly = piece.polygon()
+    lo, hi = poly.min(axis=0), poly.max(axis=0)
+    gx, gy = np.meshgrid(np.linspace(lo[0], hi[0], MOMENT_GRID), np.linspace(lo[1], hi[1], MOMENT_GRID))
+    grid = np.c_[gx.ravel(), gy.ravel()]
+    inside = grid[polygon_inside(grid, poly)]
+    if len(inside) < 3:
+        return None
+    centre = inside.mean(axis=0)
+    _, vecs = np.linalg.eigh(np.cov((inside - centre).T))
+    axis = vecs[:, -1]
+    if abs(axis[1]) >= abs(axis[0]):  # run downwards (a hand draws down a panel), else left to right
+        axis = axis if axis[1] < 0 else -axis
+    elif axis[0] < 0:
+        axis = -axis
+    reach = float(np.linalg.norm(hi - lo))
+    t = np.arange(-reach, reach, 0.25)
+    line = centre + t[:, None] * axis
+    ok = polygon_inside(line, poly) & (polygon_distance(line, poly) >= params.margin_cm)
+    if not ok.any():
+        return None
+    # The run of inside samples nearest the centroid (a C-shaped piece has several).
+    edges = np.flatnonzero(np.diff(np.r_[0, ok.astype(np.int8), 0]))
+    runs = edges.reshape(-1, 2)
+    mid = int(np.argmin(np.abs(t)))
+    best = min(runs, key=lambda r: 0 if r[0] <= mid < r[1] else min(abs(r[0] - mid), abs(r[1] - 1 - mid)))
+    a, b = t[best[0]], t[best[1] - 1]
+    cut = params.trim * (b - a)
+    a, b = a + cut, b - cut
+    if b - a < params.min_length_cm:
+        return None
+    n = max(2, int(np.ceil((b - a) / params.step_cm)) + 1)
+    return centre + np.linspace(a, b, n)[:, None] * axis
+
+
+def _placed_normals(piece: Piece, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """World points (n, 3) metres of piece points (n, 2) cm and the placed piece's outer normals there (n, 3)
+    (by finite differences, so a folded placement bends them over its fold)."""
+    pl = piece.placement
+    x = pl.apply(pts)
+    du = pl.apply(pts + [0.5, 0.0]) - x
+    dv = pl.apply(pts + [0.0, 0.5]) - x
+    n = np.cross(du, dv)  # counter-clockwise seen from the outer face: local x, y, z right-handed
+    return x, n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+
+
+def carry_to_body(surface: Surface, points: np.ndarray, normals: np.ndarray, reach_m: float) -> np.ndarray:
+    """(n, 3) metres: for each placed point, the body point nearest it on the line along its normal, within
+    `reach_m` on either side; NaN where the line meets the body nowhere that close."""
+    origins = points + reach_m * normals
+    ray, hits = surface.ray_hits(origins, -normals)
+    out = np.full_like(points, np.nan)
+    if not len(ray):
+        return out
+    gap = np.abs(hits.distance - reach_m)
+    order = np.lexsort((gap, ray))
+    first = order[np.r_[True, ray[order][1:] != ray[order][:-1]]]
+    keep = first[gap[first] <= reach_m]
+    out[ray[keep]] = hits.points[keep]
+    return out
+
+
+def _longest_run(ok: np.ndarray) -> tuple[int, int]:
+    """[start, stop) of the longest run of True in a boolean (n,) array; (0, 0) if none."""
+    edges = np.flatnonzero(np.diff(np.r_[0, ok.astype(np.int8), 0])).reshape(-1, 2)
+    if not len(edges):
+        return 0, 0
+    k = int(np.argmax(edges[:, 1] - edges[:, 0]))
+    return int(edges[k, 0]), int(edges[k, 1])
+
+
+def _trim_to(points: np.ndarray, length: float) -> np.ndarray:
+    """The middle part of a polyline (n, d), `length` long (in its units), with as many points."""
+    total = float(arc_length(points)[-1])
+    mid = 0.5 * total
+    return interpolate_polyline(points, np.linspace(mid - 0.5 * length, mid + 0.5 * length, len(points)))
+
+
+def suggest_pair(piece: Piece, surface: Surface, params: SuggestParams) -> tuple[np.ndarray, np.ndarray] | None:
+    """One stroke pair for a placed piece: (pattern points (n, 2) cm in the piece's own coordinates, body points
+    (n, 3) metres on the surface), as long as each other; None when no part of its stroke reaches the body."""
+    pat = long_axis_stroke(piece, params)
+    if pat is None:
+        return None
+    placed, normals = _placed_normals(piece, pat)
+    on = carry_to_body(surface, placed, normals, params.reach_m)
+    ok = np.isfinite(on).all(axis=1)
+    step = np.linalg.norm(np.diff(np.where(ok[:, None], on, 0.0), axis=0), axis=1)
+    joined = ok[:-1] & ok[1:] & (step <= params.jump_m + 2e-2 * params.step_cm)
+    # Points i..j form a run when every link between them is joined.
+    a, b = _longest_run(joined)
+    if b <= a:
+        return None
+    pat, body = pat[a : b + 1], on[a : b + 1]
+    lp, lb = float(arc_length(pat)[-1]), float(arc_length(body)[-1]) * 100.0
+    if min(lp, lb) < params.min_length_cm:
+        return None
+    if lb > lp:
+        body = _trim_to(body, lp / 100.0)
+    else:
+        pat = _trim_to(pat, lb)
+    return pat, surface.closest(body).points
+
+
+def suggest_strokes(
+    body,
+    pattern: Pattern,
+    *,
+    params: SuggestParams | None = None,
+    surface: Surface | None = None,
+) -> Strokes:
+    """A stroke set for `pattern` on `body` from the pattern's placement (module docstring).
+
+    body : a `kitsuke.body.Body` or a TriMesh, metres, in the frame the placement was made for.
+    pattern : a Pattern whose pieces carry placements (GarmentCode's, the kimono generator's).
+    Returns Strokes (target "body"), one pair per piece that got a stroke, largest piece first, pattern points in
+    the coordinates of the pattern's file (as a user draws them). Raises InputError when no piece has a
+    placement, or when no stroke can be carried to the body (the placement was made for another body).
+    """
+    p = params or SuggestParams()
+    placed = [pc for pc in pattern.pieces if pc.placement is not None]
+    if not placed:
+        raise InputError(
+            f"pattern {pattern.name!r} carries no placement: strokes can only be suggested for a pattern that says "
+            "where its pieces go (GarmentCode's, a kimono from `kitsuke pattern kimono`); draw them instead"
+        )
+    mesh = body if isinstance(body, TriMesh) else body.mesh
+    surf = surface if surface is not None else Surface(mesh)
+    largest = max(pc.area for pc in placed)
+    pairs: list[StrokePair] = []
+    for piece in sorted(placed, key=lambda pc: -pc.area):
+        if piece.area < p.min_area_share * largest:
+            continue
+        got = suggest_pair(piece, surf, p)
+        if got is None:
+            continue
+        pat, on = got
+        pairs.append(
+            StrokePair(
+                len(pairs) + 1,
+                PatternStroke(piece.name, np.round(pattern.piece_to_file(piece.name, pat), 2)),
+                BodyStroke(points=np.round(on, 4)),
+            )
+        )
+    if not pairs:
+        raise InputError(
+            f"no stroke of pattern {pattern.name!r} reaches the body along its placement: is the placement made "
+            "for another body (or in other units)?"
+        )
+    meta = {"made_by": "kitsuke strokes suggest", "pattern": pattern.name}
+    return Strokes(pairs, "body", meta)
