@@ -190,3 +190,41 @@ def test_bad_arguments_are_rejected():
         restore_lengths(model, state, tethers=Tethers.from_polylines([([60], [[1, 0, 0]], line)], other.faces, 0.01))
     with pytest.raises(InputError, match="reach"):
         Tethers.from_polylines([([0], [[1, 0, 0]], line)], model.faces, 0.0)
+
+
+def _pulled_apart_sheet():
+    """A sheet pinned on its left column whose right column is tethered to a line 30 cm past where the cloth can
+    reach: the edges and the tethers cannot both be met."""
+    model, rest = flat_sheet(30, 10, 0.02, gravity_step_m=0.0)
+    pins = rest[:, 0] == 0.0
+    right = np.flatnonzero(rest[:, 0] == rest[:, 0].max())
+    face = np.array([np.flatnonzero((model.faces == v).any(axis=1))[0] for v in right])
+    bary = (model.faces[face] == right[:, None]).astype(float)
+    tethers = Tethers.from_polylines([(face, bary, np.array([[0.9, -1.0, 0.0], [0.9, 1.0, 0.0]]))], model.faces, 0.001)
+    return model, rest, pins, tethers
+
+
+def test_accelerated_sweeps_that_run_away_are_run_again_plain():
+    """Chebyshev extrapolation fighting tethers can grow without bound (GarmentCode's shirt on strokes drawn from
+    its placement reached 1e18 m); such a run is detected and done again from the start, plain, with the very
+    result of a plain run."""
+    model, rest, pins, tethers = _pulled_apart_sheet()
+    fast = ClothState.new(model, rest.copy(), pinned=pins)
+    stats = restore_lengths(model, fast, sweeps=400, tethers=tethers, chebyshev_rho=0.9999, over_relaxation=1.9)
+    assert stats.restarted
+    plain = ClothState.new(model, rest.copy(), pinned=pins)
+    assert not restore_lengths(model, plain, sweeps=400, tethers=tethers).restarted
+    np.testing.assert_array_equal(fast.positions, plain.positions)
+    assert np.isfinite(fast.positions).all() and np.abs(fast.positions).max() < 1.0
+
+
+def test_sweeps_that_run_away_even_plain_raise_a_computation_error():
+    """Rest lengths a hundred times the cloth's: every sweep throws vertices metres; nothing usable comes out."""
+    from kitsuke.cloth import ClothModel
+    from kitsuke.errors import ComputationError
+
+    model, rest = flat_sheet(6, 6, 0.02, gravity_step_m=0.0)
+    huge = ClothModel.from_corners(model.faces, rest[model.faces][..., :2] * 100.0, n_vertices=len(rest))
+    state = ClothState.new(huge, rest.copy(), pinned=rest[:, 0] == 0.0)
+    with pytest.raises(ComputationError, match="length restoration"):
+        restore_lengths(huge, state, sweeps=50)

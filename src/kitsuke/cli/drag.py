@@ -57,6 +57,7 @@ def run(args: argparse.Namespace) -> int:
     import time
 
     from .._files import write_json_atomic
+    from ..cloth import precompile_in_background
     from ..dressing.drag import DragParams, DragSession
     from ..dressing.drags import apply_drags, read_drags
     from ..dressing.export import read_garment_obj, write_garment_obj, write_garment_png
@@ -74,6 +75,7 @@ def run(args: argparse.Namespace) -> int:
     # Cheap checks first: bad drags or garment files fail before the body is loaded.
     drags = read_drags(args.drags)
     garment = read_garment_obj(args.garment)
+    precompile_in_background()  # the first run after an install: compile the release's polish on the other core
     body = body_from_args(args)
     t0 = time.perf_counter()
     session = DragSession(body, garment, params=DragParams(max_step_m=args.step / 100), source=args.garment)

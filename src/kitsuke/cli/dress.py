@@ -114,6 +114,7 @@ def register(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..cloth import precompile_in_background
     from ..dressing import check_strokes, read_strokes, target_misses
     from ..dressing.kimono import is_kimono, kimono_params
     from ..dressing.wrap import DressedGarment, WrapParams, wrap
@@ -149,6 +150,8 @@ def run(args: argparse.Namespace) -> int:
     pattern = load_pattern(args.pattern)
     strokes = read_strokes(args.strokes)
     check_strokes(strokes, pattern)
+    if not args.no_polish:
+        precompile_in_background()  # the first run after an install: compile the polish on the other core
     body = body_from_args(args)
     make = WrapParams.strokes_held if args.hold_strokes else WrapParams
     reach = args.stroke_reach * 1e-3 if args.stroke_reach > 0 else None

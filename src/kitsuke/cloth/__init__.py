@@ -25,7 +25,8 @@ from ._collide import (
 )
 from ._lengths import LengthStats, restore_lengths
 from ._model import ClothModel, ClothParams, ClothState, Contacts, locality_order
-from ._polish import PolishStats, RefinedPolish, bending_stencil, polish, polish_refined
+from ._polish import PolishStats, RefinedPolish, bending_stencil, compile_polish, polish, polish_refined
+from ._precompile import precompile_in_background
 from ._relax import RelaxStats, relax
 from ._shapes import grid_sheet, grid_tube, hugging_tube, triangle_frames
 from ._subdivide import Refinement, colliding_edges, refine, sqrt3_split
@@ -48,6 +49,8 @@ __all__ = [
     "Tethers",
     "UntangleStats",
     "collide",
+    "compile_polish",
+    "precompile_in_background",
     "folded_faces",
     "grow_region",
     "keep_layers",

@@ -20,7 +20,7 @@ PARALLEL = os.environ.get("KITSUKE_NUMBA_PARALLEL", "1") != "0"
 WALK_IMPROVEMENT = 1e-10
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def closest_on_triangle(px, py, pz, bv, i0, i1, i2):
     """Nearest point of triangle (bv[i0], bv[i1], bv[i2]) to p: (cx, cy, cz, b0, b1, b2, region)."""
     ax, ay, az = bv[i0, 0], bv[i0, 1], bv[i0, 2]
@@ -61,7 +61,7 @@ def closest_on_triangle(px, py, pz, bv, i0, i1, i2):
     return ax + v * abx + w * acx, ay + v * aby + w * acy, az + v * abz + w * acz, 1.0 - v - w, v, w, 0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _pseudo_normal(f, region, bf, face_n, edge_n, vert_n):
     """Angle-weighted pseudo-normal of the feature `region` of face f: its sign test is exact for the true
     nearest point of a closed mesh (Baerentzen & Aanaes 2005)."""
@@ -74,7 +74,7 @@ def _pseudo_normal(f, region, bf, face_n, edge_n, vert_n):
     return edge_n[f, k, 0], edge_n[f, k, 1], edge_n[f, k, 2]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _store(
     i,
     px,
@@ -308,7 +308,7 @@ def push_out(pos, movable, offset, c_face, c_normal, c_dist):
     return pushed, deepest
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _segment_point(px, py, pz, ax, ay, az, bx, by, bz):
     """Parameter t in [0, 1] of the point of segment a-b nearest p."""
     ux, uy, uz = bx - ax, by - ay, bz - az
@@ -366,7 +366,7 @@ def capsule_vertices(pos, movable, ends, radii, lo, hi, margin, out_near):
         out_near[i] = bits
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def segment_segment(p1x, p1y, p1z, q1x, q1y, q1z, p2x, p2y, p2z, q2x, q2y, q2z):
     """Parameters (s, t) in [0, 1] of the nearest points of segments p1-q1 and p2-q2 (clamped closest points)."""
     d1x, d1y, d1z = q1x - p1x, q1y - p1y, q1z - p1z

@@ -93,6 +93,38 @@ class PolishStats:
     folded: int = 0
 
 
+def energy_terms(
+    edges, rest, hinges, bend_w, bend_coef, near, points, normals, offset, layer_v, layer_tri, layer_b, layer_n,
+    layer_gap, tether_tri, tether_bary, targets, reach,
+) -> tuple:  # fmt: skip
+    """The argument tuple of `polish_energy` (and `minimise`): the arrays with the module's weights between them.
+    One place builds it, so `compile_polish` compiles the very signature `polish` calls."""
+    return (
+        edges, rest, STRETCH_WEIGHT, LIMIT_WEIGHT, LIMIT_STRAIN,
+        hinges, bend_w, bend_coef,
+        near, points, normals, float(offset), CONTACT_WEIGHT,
+        layer_v, layer_tri, layer_b, layer_n, float(layer_gap), LAYER_WEIGHT,
+        tether_tri, tether_bary, targets, float(reach), TETHER_WEIGHT,
+    )  # fmt: skip
+
+
+def compile_polish() -> None:
+    """Compile the polish's L-BFGS and energy (`minimise`), or load them from numba's cache, on a one-triangle
+    sheet: the same argument types as `polish` (`energy_terms`). The longest compile of a wrap (7-8 s of a cold
+    `kitsuke dress`); `kitsuke.cloth.precompile_in_background` runs this in another process while the wrap
+    compiles and runs its earlier stages."""
+    i3, f3 = np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3))
+    x = np.array([[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.0, 0.01, 0.0]])
+    terms = energy_terms(
+        np.array([[0, 1], [1, 2], [0, 2]], dtype=np.int64), np.full(3, 0.01),
+        np.zeros((0, 4), dtype=np.int64), np.zeros((0, 4)), np.zeros(0),
+        np.zeros(0, dtype=np.int64), f3, f3, 0.001,
+        np.zeros(0, dtype=np.int64), i3, f3, f3, 0.002,
+        i3, f3, f3, 0.0,
+    )  # fmt: skip
+    minimise(x, np.arange(3, dtype=np.int64), 1, LBFGS_MEMORY, terms)
+
+
 def polish(
     model: ClothModel,
     state: ClothState,
@@ -154,12 +186,10 @@ def polish(
         targets = np.zeros((0, 3))
         if tethers is not None and len(tethers):
             targets = np.ascontiguousarray(tethers.nearest(state.positions)[tethered])
-        terms = (
-            edges, rest, STRETCH_WEIGHT, LIMIT_WEIGHT, LIMIT_STRAIN,
-            hinges, bend_w, np.ascontiguousarray(bend_coef * hinge_weight),
-            near, points, normals, offset, CONTACT_WEIGHT,
-            layer_v, layer_tri, layer_b, layer_n, layer_gap, LAYER_WEIGHT,
-            tether_tri, tether_bary, targets, reach, TETHER_WEIGHT,
+        terms = energy_terms(
+            edges, rest, hinges, bend_w, np.ascontiguousarray(bend_coef * hinge_weight),
+            near, points, normals, offset, layer_v, layer_tri, layer_b, layer_n, layer_gap,
+            tether_tri, tether_bary, targets, reach,
         )  # fmt: skip
         energy, done, _ = minimise(state.positions, free, iterations, LBFGS_MEMORY, terms)
         stats.iterations += int(done)

@@ -22,7 +22,7 @@ from ..cloth._collide_kernels import PARALLEL
 EPS = 1e-12
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _point(bv, bf, f, b0, b1, b2):
     i0, i1, i2 = bf[f, 0], bf[f, 1], bf[f, 2]
     return (
@@ -32,7 +32,7 @@ def _point(bv, bf, f, b0, b1, b2):
     )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _interp_unit(vals, bf, f, b0, b1, b2):
     """Barycentric interpolation of per-vertex vectors vals (Vb, 3) in face f, normalised (0 if it vanishes)."""
     i0, i1, i2 = bf[f, 0], bf[f, 1], bf[f, 2]
@@ -45,7 +45,7 @@ def _interp_unit(vals, bf, f, b0, b1, b2):
     return 0.0, 0.0, 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _pick(k, x0, x1, x2):
     return x0 if k == 0 else (x1 if k == 1 else x2)
 

@@ -1,0 +1,96 @@
+"""The wrap on strokes a hand would draw: either way round, longer or shorter than the pattern stroke; and its
+honest outcome: a result that is not a garment on the body raises ComputationError naming what failed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from kitsuke.dressing import (
+    BodyStroke,
+    PatternStroke,
+    StrokePair,
+    Strokes,
+    WrapParams,
+    on_body_failures,
+    target_misses,
+    wrap,
+)
+from kitsuke.errors import ComputationError
+from kitsuke.metrics import QualityTargets
+
+from .test_wrap import _sphere, _square
+
+PARAMS = WrapParams(edge_length_cm=2.0, settle_iterations=40)
+
+
+def _meridian(radius_m: float, length_m: float, up: bool = True) -> np.ndarray:
+    """Points up (or down) the front of a sphere (+z), centred on its equator, `length_m` long."""
+    ang = np.linspace(-0.5, 0.5, 9) * length_m / radius_m
+    pts = np.c_[np.zeros_like(ang), radius_m * np.sin(ang), radius_m * np.cos(ang)]
+    return pts if up else pts[::-1]
+
+
+def _upright(body_points: np.ndarray) -> Strokes:
+    """A 16 cm stroke up the middle of the 20 cm square (pattern y is up)."""
+    return Strokes(
+        [StrokePair(1, PatternStroke("square", [[10.0, 2.0], [10.0, 18.0]]), BodyStroke(points=body_points))]
+    )
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    return _sphere(0.3)
+
+
+@pytest.fixture(scope="module")
+def drawn_up(sphere):
+    return wrap(sphere, _square(), _upright(_meridian(0.3, 0.16)), params=PARAMS)
+
+
+def test_a_body_stroke_drawn_the_other_way_is_taken_the_right_way(sphere, drawn_up):
+    down = wrap(sphere, _square(), _upright(_meridian(0.3, 0.16, up=False)), params=PARAMS)
+    assert [t.reversed for t in down.tracks] == [True] and [t.reversed for t in drawn_up.tracks] == [False]
+    # The pattern's top lies at the top either way.
+    top = [g.positions[g.pattern_vertex[np.argmax(g.pattern_mesh.vertices_cm[:, 1])], 1] for g in (drawn_up, down)]
+    assert top[0] > 0.05 and top[1] == pytest.approx(top[0], abs=0.01)  # measured 0.090 m both
+    assert down.report.strain_max < 0.3 and down.max_stroke_residual_m < 0.01
+
+
+@pytest.mark.parametrize("ratio", [0.7, 1.3])
+def test_the_cloth_keeps_its_own_length_whatever_the_body_stroke_length(sphere, drawn_up, ratio):
+    """A body stroke 0.7 or 1.3 times its pattern stroke says where the cloth lies, not how long it is: the
+    placed cloth is not squeezed or stretched to fit it (with the paper's arc-length correspondence the shirt
+    ended at 31 % max strain for a body stroke 10 % short, 179 % for 30 %)."""
+    g = wrap(sphere, _square(), _upright(_meridian(0.3, 0.16 * ratio)), params=PARAMS)
+    assert g.stroke_length_ratio[0] == pytest.approx(ratio, rel=0.03)
+    assert g.report.strain_mean < 1.5 * max(drawn_up.report.strain_mean, 0.005)
+    assert g.report.strain_max < 0.3
+    assert g.max_stroke_residual_m < 0.01  # the cloth's stroke lies along the drawn one (continued past its ends)
+
+
+def test_strokes_that_no_garment_can_meet_raise_and_name_what_failed(sphere):
+    """Two strokes 16 cm apart on the square, drawn on opposite sides of the sphere (60 cm apart): no square can
+    lie there. The wrap raises ComputationError naming the failure, with the unusable garment for inspection."""
+    back = _meridian(0.3, 0.16) * [1.0, 1.0, -1.0]
+    strokes = Strokes(
+        [
+            StrokePair(1, PatternStroke("square", [[2.0, 2.0], [2.0, 18.0]]), BodyStroke(points=_meridian(0.3, 0.16))),
+            StrokePair(2, PatternStroke("square", [[18.0, 2.0], [18.0, 18.0]]), BodyStroke(points=back)),
+        ]
+    )
+    with pytest.raises(ComputationError, match=r"^wrap: not a garment on the body: (stroke \d|piece square)") as e:
+        wrap(sphere, _square(), strokes, params=PARAMS)
+    garment = e.value.result
+    assert garment is not None and on_body_failures(garment, sphere)
+    # check=False returns it, for callers that judge it themselves.
+    assert wrap(sphere, _square(), strokes, params=PARAMS, check=False).n_vertices == garment.n_vertices
+
+
+def test_a_garment_on_the_body_reports_the_targets_it_misses(drawn_up):
+    assert on_body_failures(drawn_up, _sphere(0.3)) == []
+    strict = QualityTargets(max_strain=1e-4, stroke_residual_mm=0.1)
+    misses = target_misses(drawn_up, strict)
+    assert any(m.startswith("max edge strain") for m in misses)
+    assert any("farther than 0.1 mm from where drawn" in m for m in misses)
+    assert drawn_up.summary()["targets_missed"] == target_misses(drawn_up)
