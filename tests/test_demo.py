@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+import pytest
 import trimesh
 from PIL import Image
 
@@ -12,6 +13,7 @@ from kitsuke.geometry import load_mesh
 from kitsuke.pattern import load_pattern
 
 
+@pytest.mark.slow
 def test_demo_writes_real_files(run_cli, tmp_path):
     out = tmp_path / "out"
     r = run_cli("demo", "--out", out, "--size", "200x250")

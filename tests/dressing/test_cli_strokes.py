@@ -41,6 +41,7 @@ def test_suggest_refuses_a_pattern_without_placement_in_one_line(run_cli, tmp_pa
     assert len(r.err.strip().splitlines()) == 1 and "carries no placement" in r.err and TSHIRT.name in r.err
 
 
+@pytest.mark.slow
 def test_dress_exits_1_on_strokes_no_garment_can_meet_and_keeps_the_result_only_when_asked(
     run_cli, suggested, tmp_path
 ):

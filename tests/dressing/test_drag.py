@@ -112,6 +112,7 @@ def test_lift_the_skirt_moves_every_vertex_5_cm_up_along_the_body(body, skirt, c
     assert_quality_kept(before, s.report())
 
 
+@pytest.mark.slow
 def test_lift_the_kimono(body, kimono, collider):
     """The kimono rises with its front: the median vertex moves 5 cm, nine in ten within 5 +- 1.5 cm, and every
     quality target still holds (measured 2026-11-25: max strain 4.77 -> 3.02 %, mean 0.33 -> 0.20 %)."""
@@ -157,6 +158,7 @@ def test_turn_the_skirt_30_degrees_around_the_waist(body, skirt, collider):
     assert_quality_kept(before, after)
 
 
+@pytest.mark.slow
 def test_turning_the_kimono_leaves_its_sleeves_round_the_arms(body, kimono, collider):
     """The kimono's front dragged 2 cm sideways, no pins: a turn about the torso. Its body turns; the cloth round
     the forearms does not (turned about the torso it was swept through the arms: 339 % max strain after one 1 cm
@@ -195,6 +197,7 @@ def test_a_body_without_capsules_turns_everything(body, skirt):
 
 
 # -- (c) pins -----------------------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_pins_down_the_back_stop_a_drag_of_the_front(body, kimono, collider):
     """A row of pins down the kimono's back seam (and the back of its collar): dragging the front up 6 cm leaves
     the pinned vertices exactly where they were, does not reach the half beyond the pins at all (< 5 mm: not a
@@ -275,6 +278,7 @@ def roll_up_left_sleeve(s: DragSession, body, kimono):
     return uv, sleeve, band, cuff
 
 
+@pytest.mark.slow
 def test_roll_up_a_kimono_sleeve(body, kimono, collider):
     """Pins round the upper arm of the left sleeve (a band across it, 7-10.5 cm from the shoulder seam), the cuff
     dragged 10 cm up the forearm towards the elbow: the cuff goes, the shoulder stays, and every quality target
@@ -304,6 +308,7 @@ def test_roll_up_a_kimono_sleeve(body, kimono, collider):
     assert np.isfinite(out.corner_uv).all() and out.piece_names == kimono.piece_names
 
 
+@pytest.mark.slow
 def test_restore_undoes_a_refining_release(body, kimono, collider):
     """A drags file found bad after a release that refined the garment puts it back as it was: the same vertices
     (count and positions), faces and pins."""
@@ -319,6 +324,7 @@ def test_restore_undoes_a_refining_release(body, kimono, collider):
 
 
 # -- rough drags ---------------------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_rough_drags_up_and_down_do_not_tear_the_coarse_kimono(body, collider):
     """The kimono at 2.5 cm (as benchmarks/bench_drag.py drags it) lifted 10 cm by its front and put back, three
     times, in 1 cm updates: its hem round the shins does not tear (206 % max strain, 2.8 % mean, when collision

@@ -72,14 +72,17 @@ def test_the_stroke_triangles_are_kept():
 def test_the_shirt_at_2_cm_keeps_its_sleeve_round_the_arm():
     """At 2 cm the close leaves the right sleeve caught round the arm (measured: edges at 5x their length, and 433 %
     max strain after the whole wrap without mending); the mend finds those edges and regrows the cloth, after which
-    none is torn and the finished shirt has no edge even 1.5x its length."""
+    none is torn. The regrown sleeve settles 3 cm from its stroke: held there, the shirt ends at 45 % max strain;
+    let go (`WrapParams.tether_strain`), at 4.5 %, its strokes reported loose (measured 2026-11-26)."""
     body = load_body(ROOT / "tests" / "data" / "bodies" / "mean_all.obj")
     pattern = load_pattern(ROOT / "tests" / "data" / "pattern" / "shirt_mean_specification.json")
     strokes = read_strokes(ROOT / "src" / "kitsuke" / "assets" / "strokes" / "shirt_mean_all.json")
     g = wrap(body, pattern, strokes, params=WrapParams(edge_length_cm=2.0))
     assert g.mend.torn_before > 10 and g.mend.rounds >= 1 and g.mend.torn_after == 0
-    assert g.report.strain_max < 0.5
-    assert g.report.inverted_count == 0 and g.max_stroke_residual_m <= 0.01
+    assert g.report.strain_max < 0.1
+    assert g.report.inverted_count == 0 and g.max_stroke_residual_m <= 0.05
+    far = [i for i, r in zip(g.stroke_ids, g.stroke_residual_m, strict=True) if r > 0.01]
+    assert set(far) <= set(g.loose_strokes)  # a stroke left far from its cloth is said to be loose
     assert g.summary()["mend"]["torn_before"] == g.mend.torn_before
 
 

@@ -51,6 +51,7 @@ def chest_pins(g) -> np.ndarray:
     return g.positions[g.positions[:, 1] > 1.0][::40]
 
 
+@pytest.mark.slow
 def test_turning_up_the_hem_moves_it_and_leaves_pins_exactly_still(body, dressed):
     before = dressed.positions.copy()
     s = hem_lift(dressed)
@@ -70,6 +71,7 @@ def test_turning_up_the_hem_moves_it_and_leaves_pins_exactly_still(body, dressed
     assert q.strain_mean < 0.015  # measured 0.0113 (the dressed kimono itself: 0.0089)
 
 
+@pytest.mark.slow
 def test_without_pins_the_garment_moves_with_its_strokes(body, dressed):
     r = rewrap(body, dressed, hem_lift(dressed, dy_cm=2.0))
     assert not r.pinned.any()
@@ -101,6 +103,7 @@ def test_rewrap_bad_input(body, dressed):
         RewrapParams(untangle_iterations=0)
 
 
+@pytest.mark.slow
 def test_cli_rewrap_writes_obj_and_report_and_refuses_bad_pins(run_cli, tmp_path, body, dressed):
     garment_obj = write_garment_obj(dressed, tmp_path / "dressed.obj")
     strokes = tmp_path / "lift.json"

@@ -106,8 +106,8 @@ def register(parser: argparse.ArgumentParser) -> None:
         "--no-polish",
         action="store_true",
         help="skip the last step, the polish (strain capped at 4.5 %%, finer triangles where a crease folds; a "
-        "re-wrap's without refinement): several times faster (GarmentCode's shirt 2.1 -> 0.4 s) but the max edge "
-        "strain stays where the settle left it (the shirt: 28 %% instead of 4.6 %%)",
+        "re-wrap's without refinement): about twice as fast (GarmentCode's shirt: 1.0 instead of 1.8 s of wrap) "
+        "but the max edge strain stays where the settle left it (the shirt: 28 %% instead of 4.5 %%)",
     )
     add_body_options(parser)
     parser.set_defaults(run=run)
