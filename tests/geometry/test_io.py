@@ -78,3 +78,24 @@ def test_unsupported_and_garbage_files(tmp_path):
 def _write(p, data):
     p.write_bytes(data)
     return p
+
+
+@pytest.mark.parametrize("form", ["{v}", "{v}/{v}", "{v}/{v}/1", "{v}//1"])
+def test_obj_plain_triangles_read_at_once_match_the_line_by_line_reader(tmp_path, form):
+    """Files of plain triangles take a vectorised path; one relative index sends the file down the line-by-line
+    one: both must agree face for face, uv for uv, group for group."""
+    from kitsuke.geometry.obj import read_obj
+
+    head = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+    tri = [(1, 2, 3), (1, 3, 4), (2, 3, 4)]
+    faces = ["f " + " ".join(form.format(v=i) for i in t) for t in tri]
+    plain = quad_obj(tmp_path, head + "g a\n" + faces[0] + "\n" + faces[1] + "\ng b\n" + faces[2] + "\n")
+    fast = read_obj(plain)
+    slow_text = plain.read_text().replace(faces[2], "f " + " ".join(form.format(v=i - 5) for i in tri[2]))
+    slow = read_obj(quad_obj(tmp_path, slow_text))
+    np.testing.assert_array_equal(fast.faces, [[0, 1, 2], [0, 2, 3], [1, 2, 3]])
+    np.testing.assert_array_equal(fast.faces, slow.faces)
+    np.testing.assert_array_equal(fast.face_group, slow.face_group)
+    assert fast.groups == slow.groups == ["default", "a", "b"]
+    if fast.face_uv is not None:
+        np.testing.assert_array_equal(fast.face_uv, slow.face_uv)

@@ -7,7 +7,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ..skeleton import JOINTS, joint_index
 from .skinning import forward_kinematics, global_rotations, rotations_from_positions, skin
@@ -48,6 +47,8 @@ RotationLike = Any  # (3, 3) matrix, (3,) rotation vector in radians, (4,) quate
 
 def as_matrix(r: RotationLike) -> np.ndarray:
     """(3, 3) rotation matrix from a matrix, a rotation vector (radians), a wxyz quaternion or a scipy Rotation."""
+    from scipy.spatial.transform import Rotation  # here: 0.15-0.3 s to import, and most commands never pose
+
     if isinstance(r, Rotation):
         return r.as_matrix()
     a = np.asarray(r, dtype=np.float64)

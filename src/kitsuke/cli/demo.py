@@ -37,7 +37,7 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError
     except ValueError:
         raise InputError(f"--size must be WxH in pixels (16-8192), got {args.size!r}") from None
-    precompile_in_background()  # the first run after an install: compile the polish on the other core
+    precompile_in_background(layers=True)  # the first run after an install: compile on the other core too
     result = run_demo(args.out, size=(w, h))
     for path, what in result.files.items():
         print(f"  {path}  {what}")

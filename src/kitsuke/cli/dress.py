@@ -151,7 +151,8 @@ def run(args: argparse.Namespace) -> int:
     strokes = read_strokes(args.strokes)
     check_strokes(strokes, pattern)
     if not args.no_polish:
-        precompile_in_background()  # the first run after an install: compile the polish on the other core
+        # The first run after an install: compile the polish (and a kimono's layer order) on the other core.
+        precompile_in_background(layers=bool(pattern.meta.get("layers")))
     body = body_from_args(args)
     make = WrapParams.strokes_held if args.hold_strokes else WrapParams
     reach = args.stroke_reach * 1e-3 if args.stroke_reach > 0 else None

@@ -440,3 +440,17 @@ def collide(model: ClothModel, state: ClothState, collider: BodyCollider) -> Col
         pos[low, 1] = collider.floor_y + p.contact_offset_m
         pushed += int(low.sum())
     return CollisionStats(searches, int(pushed), float(deepest))
+
+
+def compile_layers() -> None:
+    """Compile the layer-order kernels (`point_grid`, `layer_moves`), or load them from numba's cache, on two
+    small overlapping sheets: the same argument types as `keep_layers` on any layered garment (4 s of a cold
+    `kitsuke demo`; see `kitsuke.cloth.precompile_in_background`)."""
+    from ._shapes import grid_sheet
+
+    uv, f = grid_sheet(3, 3, 0.02)
+    faces = np.concatenate([f, f + len(uv)])
+    layer = np.r_[np.ones(len(f), dtype=np.int8), np.full(len(f), 2, dtype=np.int8)]
+    model = ClothModel.from_corners(faces, np.concatenate([uv[f], uv[f]]), face_layer=layer)
+    pos = np.concatenate([np.c_[uv, np.zeros(len(uv))], np.c_[uv + 0.005, np.full(len(uv), -0.001)]])
+    keep_layers(model, ClothState.new(model, pos))

@@ -1,11 +1,12 @@
-"""Compile the slowest numba kernel in another process while the first command after an install runs.
+"""Compile the slowest numba kernels in another process while the first command after an install runs.
 
 numba compiles each kernel on its first call and keeps it in its cache (`cache=True`), so only the first run after
-an install (or a change of the code) pays. Of a cold `kitsuke dress` (24 s on 2 cores, 2026-11-26), the polish's
-L-BFGS and energy take 7-8 s, and the polish comes last. `precompile_in_background` starts a second process that
-compiles them (`_polish.compile_polish`) into the cache while this one compiles and runs the wrap's earlier
-stages; when the polish is reached, its kernels load from the cache. With one core the two share it and nothing
-is lost; a run whose cache is already warm starts nothing.
+an install (or a change of the code) pays. Of a cold `kitsuke dress` of GarmentCode's shirt (19.4 s on 2 cores,
+2026-11-26), the polish's L-BFGS and energy take 6-8 s, and the polish comes last; of a cold `kitsuke demo`, the
+kimono's layer order takes another 4 s. `precompile_in_background` starts a second process that compiles them into
+the cache (`_collide.compile_layers` first when asked, as the wrap needs it early; then `_polish.compile_polish`)
+while this one compiles and runs the wrap's earlier stages; when they are reached, they load from the cache. With
+one core the two share it and nothing is lost; a run whose cache is already warm starts nothing.
 """
 
 from __future__ import annotations
@@ -15,30 +16,45 @@ import subprocess
 import sys
 
 
-def polish_cached() -> bool:
-    """Whether numba's cache holds the polish's kernels already (their index file exists); True when it cannot
-    tell (so nothing is started)."""
-    from ._lbfgs import minimise
-
+def _cached(kernel) -> bool:
+    """Whether numba's cache holds `kernel` already (its index file exists); True when it cannot tell."""
     try:
-        return os.path.exists(minimise._cache._cache_file._index_path)
+        return os.path.exists(kernel._cache._cache_file._index_path)
     except AttributeError:  # another numba: its cache layout is not known here
         return True
 
 
-def precompile_in_background() -> subprocess.Popen | None:
-    """Start compiling the polish's kernels in a background process when they are not cached yet; returns the
-    process (it exits on its own, also after this one) or None."""
-    if polish_cached():
+def polish_cached() -> bool:
+    """Whether numba's cache holds the polish's kernels already."""
+    from ._lbfgs import minimise
+
+    return _cached(minimise)
+
+
+def layers_cached() -> bool:
+    """Whether numba's cache holds the layer-order kernels already."""
+    from ._collide_kernels import layer_moves
+
+    return _cached(layer_moves)
+
+
+def precompile_in_background(*, layers: bool = False) -> subprocess.Popen | None:
+    """Start compiling the polish's kernels (and first, with `layers`, the layer order's: a kimono) in a background
+    process when they are not cached yet; returns the process (it exits on its own, also after this one) or None."""
+    steps = []
+    if layers and not layers_cached():
+        steps.append("from kitsuke.cloth._collide import compile_layers; compile_layers()")
+    if not polish_cached():
+        steps.append("from kitsuke.cloth._polish import compile_polish; compile_polish()")
+    if not steps:
         return None
-    code = "from kitsuke.cloth._polish import compile_polish; compile_polish()"
     try:
         return subprocess.Popen(
-            [sys.executable, "-c", code],
+            [sys.executable, "-c", "; ".join(steps)],
             stdin=subprocess.DEVNULL,
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
             start_new_session=True,
         )
-    except OSError:  # no process could be started: the polish compiles when it runs, as it would anyway
+    except OSError:  # no process could be started: the kernels compile when they run, as they would anyway
         return None

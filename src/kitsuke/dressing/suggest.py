@@ -72,32 +72,32 @@ class SuggestParams:
             )
 
 
-def long_axis_stroke(piece: Piece, params: SuggestParams) -> np.ndarray | None:
-    """(n, 2) cm: the piece's stroke along its long axis (principal axis of its area) through its centroid,
-    `margin_cm` inside the outline and trimmed by `trim` at each end; None when nothing of it is long enough."""
-    poly = piece.polygon()
+def _area_samples(poly: np.ndarray) -> np.ndarray:
+    """(m, 2) cm: grid points inside a polygon, MOMENT_GRID across its bounding box."""
     lo, hi = poly.min(axis=0), poly.max(axis=0)
     gx, gy = np.meshgrid(np.linspace(lo[0], hi[0], MOMENT_GRID), np.linspace(lo[1], hi[1], MOMENT_GRID))
     grid = np.c_[gx.ravel(), gy.ravel()]
-    inside = grid[polygon_inside(grid, poly)]
-    if len(inside) < 3:
-        return None
-    centre = inside.mean(axis=0)
-    _, vecs = np.linalg.eigh(np.cov((inside - centre).T))
-    axis = vecs[:, -1]
-    if abs(axis[1]) >= abs(axis[0]):  # run downwards (a hand draws down a panel), else left to right
-        axis = axis if axis[1] < 0 else -axis
-    elif axis[0] < 0:
-        axis = -axis
-    reach = float(np.linalg.norm(hi - lo))
+    return grid[polygon_inside(grid, poly)]
+
+
+def _downwards(axis: np.ndarray) -> np.ndarray:
+    """A direction (2,) as a hand draws it: down a panel, or left to right when it runs across."""
+    if abs(axis[1]) >= abs(axis[0]):
+        return axis if axis[1] < 0 else -axis
+    return axis if axis[0] > 0 else -axis
+
+
+def stroke_through(piece: Piece, point: np.ndarray, axis: np.ndarray, params: SuggestParams) -> np.ndarray | None:
+    """(n, 2) cm: the stroke along `axis` through `point` of the piece, `margin_cm` inside its outline (the inside
+    run nearest `point`) and trimmed by `trim` at each end; None when it is shorter than `min_length_cm`."""
+    poly = piece.polygon()
+    reach = float(np.linalg.norm(np.ptp(poly, axis=0)))
     t = np.arange(-reach, reach, 0.25)
-    line = centre + t[:, None] * axis
+    line = point + t[:, None] * axis
     ok = polygon_inside(line, poly) & (polygon_distance(line, poly) >= params.margin_cm)
     if not ok.any():
         return None
-    # The run of inside samples nearest the centroid (a C-shaped piece has several).
-    edges = np.flatnonzero(np.diff(np.r_[0, ok.astype(np.int8), 0]))
-    runs = edges.reshape(-1, 2)
+    runs = np.flatnonzero(np.diff(np.r_[0, ok.astype(np.int8), 0])).reshape(-1, 2)
     mid = int(np.argmin(np.abs(t)))
     best = min(runs, key=lambda r: 0 if r[0] <= mid < r[1] else min(abs(r[0] - mid), abs(r[1] - 1 - mid)))
     a, b = t[best[0]], t[best[1] - 1]
@@ -106,7 +106,41 @@ def long_axis_stroke(piece: Piece, params: SuggestParams) -> np.ndarray | None:
     if b - a < params.min_length_cm:
         return None
     n = max(2, int(np.ceil((b - a) / params.step_cm)) + 1)
-    return centre + np.linspace(a, b, n)[:, None] * axis
+    return point + np.linspace(a, b, n)[:, None] * axis
+
+
+def candidate_strokes(piece: Piece, params: SuggestParams) -> list[np.ndarray]:
+    """Pattern strokes (n, 2) cm worth trying on a piece, best first: along its long axis (the principal axis of
+    its area) and, on a placed piece, along the world's vertical, each through its centroid and through points
+    across it (a dart through the centroid, or a side that wraps out of reach, spoils one line, not all)."""
+    inside = _area_samples(piece.polygon())
+    if len(inside) < 3:
+        return []
+    centre = inside.mean(axis=0)
+    _, vecs = np.linalg.eigh(np.cov((inside - centre).T))
+    axes = [_downwards(vecs[:, -1])]
+    if piece.placement is not None:
+        up = piece.placement.matrix[1, :2]  # the world's Y in piece coordinates (ignoring any fold)
+        if np.linalg.norm(up) > 0.5:
+            vertical = _downwards(up / np.linalg.norm(up))
+            if abs(float(vertical @ axes[0])) < 0.97:
+                axes.append(vertical)
+    out = []
+    for axis in axes:
+        across = np.array([-axis[1], axis[0]])
+        width = float(np.ptp(inside @ across))
+        for shift in (0.0, -0.2, 0.2, -0.35, 0.35):
+            stroke = stroke_through(piece, centre + shift * width * across, axis, params)
+            if stroke is not None:
+                out.append(stroke)
+    return out
+
+
+def long_axis_stroke(piece: Piece, params: SuggestParams) -> np.ndarray | None:
+    """(n, 2) cm: the piece's stroke along its long axis through its centroid (`candidate_strokes`' first), or
+    None."""
+    found = candidate_strokes(piece, params)
+    return found[0] if found else None
 
 
 def _placed_normals(piece: Piece, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -154,23 +188,26 @@ def _trim_to(points: np.ndarray, length: float) -> np.ndarray:
 
 def suggest_pair(piece: Piece, surface: Surface, params: SuggestParams) -> tuple[np.ndarray, np.ndarray] | None:
     """One stroke pair for a placed piece: (pattern points (n, 2) cm in the piece's own coordinates, body points
-    (n, 3) metres on the surface), as long as each other; None when no part of its stroke reaches the body."""
-    pat = long_axis_stroke(piece, params)
-    if pat is None:
+    (n, 3) metres on the surface), as long as each other: of `candidate_strokes`, the one whose longest part
+    reaches the body; None when none does."""
+    best, best_length = None, params.min_length_cm
+    for pat in candidate_strokes(piece, params):
+        placed, normals = _placed_normals(piece, pat)
+        on = carry_to_body(surface, placed, normals, params.reach_m)
+        ok = np.isfinite(on).all(axis=1)
+        step = np.linalg.norm(np.diff(np.where(ok[:, None], on, 0.0), axis=0), axis=1)
+        joined = ok[:-1] & ok[1:] & (step <= params.jump_m + 2e-2 * params.step_cm)
+        a, b = _longest_run(joined)  # points a..b: every link between them joined
+        if b <= a:
+            continue
+        p_run, b_run = pat[a : b + 1], on[a : b + 1]
+        lp, lb = float(arc_length(p_run)[-1]), float(arc_length(b_run)[-1]) * 100.0
+        if min(lp, lb) < best_length + 1.0:  # a longer candidate must win by a centimetre
+            continue
+        best, best_length = (p_run, b_run, lp, lb), min(lp, lb)
+    if best is None:
         return None
-    placed, normals = _placed_normals(piece, pat)
-    on = carry_to_body(surface, placed, normals, params.reach_m)
-    ok = np.isfinite(on).all(axis=1)
-    step = np.linalg.norm(np.diff(np.where(ok[:, None], on, 0.0), axis=0), axis=1)
-    joined = ok[:-1] & ok[1:] & (step <= params.jump_m + 2e-2 * params.step_cm)
-    # Points i..j form a run when every link between them is joined.
-    a, b = _longest_run(joined)
-    if b <= a:
-        return None
-    pat, body = pat[a : b + 1], on[a : b + 1]
-    lp, lb = float(arc_length(pat)[-1]), float(arc_length(body)[-1]) * 100.0
-    if min(lp, lb) < params.min_length_cm:
-        return None
+    pat, body, lp, lb = best
     if lb > lp:
         body = _trim_to(body, lp / 100.0)
     else:

@@ -55,6 +55,7 @@ def read_obj(path: str | Path) -> ObjData:
     group = 0
     n_poly = 0
     comments: list[str] = []
+    face_lines: list[tuple[str, int, int, int, int]] = []  # (corners, group, line number, v and vt seen so far)
     for lineno, raw in enumerate(text.splitlines(), start=1):
         line = raw.strip()
         if not line:
@@ -73,28 +74,22 @@ def read_obj(path: str | Path) -> ObjData:
                 groups.append(name)
             group = groups.index(name)
         elif tag == "f":
-            corners = rest.split()
-            if len(corners) < 3:
-                raise InputError(f"line {lineno}: a face needs at least 3 corners", path)
-            try:
-                vi, ti = [], []
-                for c in corners:
-                    parts = c.split("/")
-                    v = int(parts[0])
-                    vi.append(v - 1 if v > 0 else len(verts) + v)
-                    if len(parts) > 1 and parts[1]:
-                        t = int(parts[1])
-                        ti.append(t - 1 if t > 0 else len(uvs) + t)
-                    else:
-                        ti.append(-1)
-            except ValueError:
-                raise InputError(f"line {lineno}: bad face index in {line!r}", path) from None
-            if len(corners) > 3:
+            # Deferred: all faces are parsed at once below (`_plain_triangles`) when they are plain triangles.
+            face_lines.append((rest, group, lineno, len(verts), len(uvs)))
+    parsed = _plain_triangles([f[0] for f in face_lines])
+    if parsed is not None:
+        tri_v, tri_t = parsed
+        tri_group = [f[1] for f in face_lines]
+    else:
+        for rest, grp, lineno, n_v, n_t in face_lines:
+            vi, ti = _face(rest, lineno, n_v, n_t, path)
+            if len(vi) > 3:
                 n_poly += 1
             for k in range(1, len(vi) - 1):  # fan triangulation (OBJ polygons are convex by convention)
                 tris.append((vi[0], vi[k], vi[k + 1]))
                 tri_uv.append((ti[0], ti[k], ti[k + 1]))
-                tri_group.append(group)
+                tri_group.append(grp)
+        tri_v, tri_t = np.array(tris, dtype=np.int64).reshape(-1, 3), np.array(tri_uv, dtype=np.int64).reshape(-1, 3)
     if not verts:
         raise InputError("no vertices (is this an OBJ file?)", path)
     try:
@@ -107,7 +102,7 @@ def read_obj(path: str | Path) -> ObjData:
         raise InputError("a 'v' line does not hold three numbers", path) from None
     if vertices.ndim != 2 or vertices.shape[1] != 3:
         raise InputError("a 'v' line does not hold three numbers", path)
-    faces = np.array(tris, dtype=np.int64).reshape(-1, 3)
+    faces = tri_v
     if len(faces) and (faces.min() < 0 or faces.max() >= len(vertices)):
         raise InputError(f"a face refers to a vertex that does not exist (file has {len(vertices)})", path)
     uv = face_uv = None
@@ -116,7 +111,51 @@ def read_obj(path: str | Path) -> ObjData:
             uv = np.array([r.split()[:2] for r in uvs], dtype=np.float64)
         except ValueError:
             raise InputError("a 'vt' line does not hold two numbers", path) from None
-        face_uv = np.array(tri_uv, dtype=np.int64).reshape(-1, 3)
+        face_uv = tri_t
         if len(face_uv) and face_uv.max() >= len(uv):
             raise InputError("a face refers to a texture coordinate that does not exist", path)
     return ObjData(vertices, faces, face_uv, uv, np.array(tri_group, dtype=np.int64), groups, n_poly, comments)
+
+
+def _face(rest: str, lineno: int, n_v: int, n_t: int, path: Path) -> tuple[list[int], list[int]]:
+    """One face line's 0-based vertex and uv indices (-1: no uv); negative indices count back from the `n_v`
+    vertices and `n_t` uvs read before the line."""
+    corners = rest.split()
+    if len(corners) < 3:
+        raise InputError(f"line {lineno}: a face needs at least 3 corners", path)
+    try:
+        vi, ti = [], []
+        for c in corners:
+            parts = c.split("/")
+            v = int(parts[0])
+            vi.append(v - 1 if v > 0 else n_v + v)
+            if len(parts) > 1 and parts[1]:
+                t = int(parts[1])
+                ti.append(t - 1 if t > 0 else n_t + t)
+            else:
+                ti.append(-1)
+    except ValueError:
+        raise InputError(f"line {lineno}: bad face index in {'f ' + rest!r}", path) from None
+    return vi, ti
+
+
+def _plain_triangles(rests: list[str]) -> tuple[np.ndarray, np.ndarray] | None:
+    """Face lines that are all triangles of positive indices in one form ("a b c", "a/t b/t c/t", "a/t/n ...",
+    "a//n ..."), parsed in one go: (F, 3) vertex and (F, 3) uv indices (-1: none), 0-based; None for anything
+    else, which the line-by-line parser then reads (a mesh of 47,500 triangles: 0.2 -> 0.05 s)."""
+    tokens = " ".join(rests).split()
+    if not tokens or len(tokens) != 3 * len(rests):
+        return None
+    slashes, double = tokens[0].count("/"), "//" in tokens[0]
+    joined = " ".join(tokens)
+    if joined.count("/") != slashes * len(tokens) or joined.count("//") != (len(tokens) if double else 0):
+        return None
+    try:
+        cols = np.array(joined.replace("/", " ").split(), dtype=np.int64).reshape(len(tokens), -1)
+    except ValueError:
+        return None
+    if cols.shape[1] != slashes + 1 - double or (cols <= 0).any():
+        return None  # relative (negative) or zero indices: the line-by-line parser says what is wrong
+    v = cols[:, 0] - 1
+    t = cols[:, 1] - 1 if slashes and not double else np.full_like(v, -1)
+    return v.reshape(-1, 3), t.reshape(-1, 3)
