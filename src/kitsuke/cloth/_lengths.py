@@ -113,25 +113,17 @@ def restore_lengths(
     if tethers is not None and len(tethers) and tethers.tri.max() >= model.n_vertices:
         raise InputError("tethers name cloth vertices the model does not have")
     start_positions = state.positions.copy()
-    stats = _sweep(
-        model,
-        state,
-        collider,
-        sweeps,
-        collide_every,
-        tolerance_m,
-        tethers,
-        over_relaxation,
-        chebyshev_rho,
-        band,
-        search_first,
-    )
+
+    def sweep(omega: float, rho: float | None) -> LengthStats | None:
+        return _sweep(
+            model, state, collider, sweeps, collide_every, tolerance_m, tethers, omega, rho, band, search_first
+        )
+
+    stats = sweep(over_relaxation, chebyshev_rho)
     if stats is None:  # ran away: again from the start, neither accelerated nor over-relaxed
         state.positions[:] = start_positions
         state.contacts.forget()
-        stats = _sweep(
-            model, state, collider, sweeps, collide_every, tolerance_m, tethers, 1.0, None, band, search_first
-        )
+        stats = sweep(1.0, None)
         if stats is None:
             raise ComputationError("length restoration", "edge projection ran away (non-finite or metres of motion)")
         stats.restarted = True
