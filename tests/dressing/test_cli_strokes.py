@@ -72,3 +72,10 @@ def test_dress_on_suggested_strokes_reports_what_it_misses(run_cli, suggested, t
     assert isinstance(summary["targets_missed"], list)
     said = r.err.strip().splitlines()[-1]
     assert ("all quality targets met" in said) == (summary["targets_missed"] == [])
+
+
+@pytest.mark.parametrize("share", ["nan", "-0.1", "1.5"])
+def test_suggest_refuses_a_bad_min_area_naming_the_flag(run_cli, tmp_path, share):
+    out = tmp_path / "s.json"
+    r = run_cli("strokes", "suggest", "--body", MEAN_ALL, "--pattern", SHIRT, "-o", out, "--min-area", share)
+    assert r.code == 2 and "--min-area" in r.err and len(r.err.strip().splitlines()) == 1 and not out.exists()

@@ -74,6 +74,8 @@ def run_suggest(args: argparse.Namespace) -> int:
     from ..pattern import load_pattern
 
     out = checked_output(args.output, [args.body, args.pattern], suffixes=(".json",))
+    if args.min_area is not None and not 0.0 <= args.min_area <= 1.0:
+        raise InputError(f"--min-area must be a share between 0 and 1, got {args.min_area}")
     pattern = load_pattern(args.pattern)
     params = SuggestParams() if args.min_area is None else SuggestParams(min_area_share=args.min_area)
     body = body_from_args(args)

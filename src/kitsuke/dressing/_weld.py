@@ -142,14 +142,11 @@ def _split_edges(pm: PatternMesh, split: np.ndarray) -> PatternMesh:
 def _where(pm: PatternMesh, merged: np.ndarray, seams: list | None) -> str:
     """Where sewing leaves a garment edge on more than two triangles: the seams whose vertices it joins (named
     from `seams`, the pattern's Seam list, when given) and a pattern point of it."""
-    f = merged[pm.faces]
-    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
-    key, count = np.unique(e[:, 0] * len(merged) + e[:, 1], return_counts=True)
-    hot = key[count > 2]
+    edges, count = edge_topology(merged[pm.faces])
+    hot = edges[count > 2]
     if not len(hot):
         return ""
-    ends = {int(hot[0] // len(merged)), int(hot[0] % len(merged))}
-    at = np.flatnonzero(np.isin(merged, list(ends)))
+    at = np.flatnonzero(np.isin(merged, hot[0]))
     involved = [i for i, sv in enumerate(pm.seam_vertices) if np.isin(np.asarray(sv).reshape(-1), at).any()]
     piece = pm.piece_names[int(pm.vertex_piece[at[0]])]
     x, y = pm.vertices_cm[at[0]]

@@ -73,28 +73,7 @@ def target_misses(garment, targets: QualityTargets | None = None) -> list[str]:
     """The quality targets a garment on the body misses, one line each (empty: all met). The report's measures
     are judged against `targets` (default: QualityTargets()), and the strokes against its stroke_residual_mm."""
     t = targets or QualityTargets()
-    r = garment.report
-    out = []
-    if r is not None:
-        lines = {
-            "penetration": (
-                r.penetration_deepest_mm > t.penetration_mm,
-                f"{r.penetration_count} vertices deeper "
-                f"than {t.penetration_mm} mm inside the body (deepest {r.penetration_deepest_mm:.1f} mm)",
-            ),
-            "max_strain": (
-                r.strain_max > t.max_strain,
-                f"max edge strain {100 * r.strain_max:.1f} % > {100 * t.max_strain:.1f} %"
-                + ("" if r.strain_worst_at is None else f" (worst on {r.strain_worst_at})"),
-            ),
-            "mean_strain": (
-                r.strain_mean > t.mean_strain,
-                f"mean edge strain {100 * r.strain_mean:.2f} % > {100 * t.mean_strain:.2f} %",
-            ),
-            "seam_gap": (r.seam_gap_mm > t.seam_gap_mm, f"seam gap {r.seam_gap_mm:.1f} mm > {t.seam_gap_mm} mm"),
-            "inverted": (r.inverted_count > t.inverted, f"{r.inverted_count} inverted triangles > {t.inverted}"),
-        }
-        out += [line for missed, line in lines.values() if missed]
+    out = [] if garment.report is None else garment.report.failures(t)
     far = [
         (sid, res)
         for sid, res in zip(garment.stroke_ids, garment.stroke_residual_m, strict=True)

@@ -88,13 +88,16 @@ def _downwards(axis: np.ndarray) -> np.ndarray:
 
 
 def stroke_through(piece: Piece, point: np.ndarray, axis: np.ndarray, params: SuggestParams) -> np.ndarray | None:
-    """(n, 2) cm: the stroke along `axis` through `point` of the piece, `margin_cm` inside its outline (the inside
-    run nearest `point`) and trimmed by `trim` at each end; None when it is shorter than `min_length_cm`."""
+    """(n, 2) cm: the stroke along `axis` through `point` of the piece, `margin_cm` inside its outline (at most a
+    quarter of its width across `axis`; the inside run nearest `point`) and trimmed by `trim` at each end; None
+    when it is shorter than `min_length_cm`."""
     poly = piece.polygon()
     reach = float(np.linalg.norm(np.ptp(poly, axis=0)))
+    # A narrow piece (a band a few cm wide) keeps a quarter of its width clear on each side instead.
+    margin = min(params.margin_cm, 0.25 * float(np.ptp(poly @ np.array([-axis[1], axis[0]]))))
     t = np.arange(-reach, reach, 0.25)
     line = point + t[:, None] * axis
-    ok = polygon_inside(line, poly) & (polygon_distance(line, poly) >= params.margin_cm)
+    ok = polygon_inside(line, poly) & (polygon_distance(line, poly) >= margin)
     if not ok.any():
         return None
     runs = np.flatnonzero(np.diff(np.r_[0, ok.astype(np.int8), 0])).reshape(-1, 2)
@@ -134,13 +137,6 @@ def candidate_strokes(piece: Piece, params: SuggestParams) -> list[np.ndarray]:
             if stroke is not None:
                 out.append(stroke)
     return out
-
-
-def long_axis_stroke(piece: Piece, params: SuggestParams) -> np.ndarray | None:
-    """(n, 2) cm: the piece's stroke along its long axis through its centroid (`candidate_strokes`' first), or
-    None."""
-    found = candidate_strokes(piece, params)
-    return found[0] if found else None
 
 
 def _placed_normals(piece: Piece, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -257,8 +253,8 @@ def suggest_strokes(
         )
     if not pairs:
         raise InputError(
-            f"no stroke of pattern {pattern.name!r} reaches the body along its placement: is the placement made "
-            "for another body (or in other units)?"
+            f"no stroke of pattern {pattern.name!r} reaches the body along its placement: its pieces are too small "
+            f"for a {p.min_length_cm:g} cm stroke, or the placement was made for another body (or in other units)"
         )
     meta = {"made_by": "kitsuke strokes suggest", "pattern": pattern.name, "settled": False}
     strokes = Strokes(pairs, "body", meta)

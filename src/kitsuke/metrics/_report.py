@@ -69,9 +69,21 @@ class QualityReport:
     def ok(self) -> bool:
         return all(self.passed.values())
 
-    def failures(self) -> list[str]:
-        """One line per measure that missed its target, saying by how much (and where, when the report knows)."""
-        t = self.targets
+    def judge(self, targets: QualityTargets) -> dict[str, bool]:
+        """{measure: met} of these measures against `targets` (the report's own: `passed`)."""
+        return {
+            "penetration": self.penetration_deepest_mm <= targets.penetration_mm,
+            "max_strain": self.strain_max <= targets.max_strain,
+            "mean_strain": self.strain_mean <= targets.mean_strain,
+            "seam_gap": self.seam_gap_mm <= targets.seam_gap_mm,
+            "inverted": self.inverted_count <= targets.inverted,
+        }
+
+    def failures(self, targets: QualityTargets | None = None) -> list[str]:
+        """One line per measure that missed its target (the report's own, or `targets`), saying by how much (and
+        where, when the report knows)."""
+        t = targets or self.targets
+        passed = self.passed if targets is None else self.judge(targets)
         worst = "" if self.strain_worst_at is None else f" (worst on {self.strain_worst_at})"
         first = "" if self.inverted_at is None else f" (first on {self.inverted_at})"
         lines = {
@@ -82,7 +94,7 @@ class QualityReport:
             "seam_gap": f"seam gap {self.seam_gap_mm:.1f} mm > {t.seam_gap_mm} mm",
             "inverted": f"{self.inverted_count} inverted triangles > {t.inverted}{first}",
         }
-        return [lines[k] for k, v in self.passed.items() if not v]
+        return [lines[k] for k, v in passed.items() if not v]
 
     def to_dict(self) -> dict:
         d = asdict(self)

@@ -243,14 +243,13 @@ def garmentcode_from_dict(d: Any, *, name: str = "garment") -> Pattern:
         if how == "placement disagrees":
             notes.append(f"stitch {i}: the placement pairs its ends the other way; reversed (both face outwards)")
         seams.append(Seam(refs[0], refs[1], rev))
-    mirrored = frozenset(p.name for p in pieces if p.name in flipped_panels)
     meta: dict[str, Any] = {"import": {"from": "garmentcode", "notes": notes}}
     renumbered = {
         p: {str(g): k for g, k in m.items()} for p, m in edge_maps.items() if any(g != k for g, k in m.items())
     }
     if renumbered:
         meta["import"]["edge_map"] = renumbered
-    return Pattern(name, pieces, seams, meta, file_mirrored=mirrored)
+    return Pattern(name, pieces, seams, meta, file_mirrored=frozenset(flipped_panels))
 
 
 def _name_from_path(path: Path) -> str:
