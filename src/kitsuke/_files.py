@@ -10,6 +10,7 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
+from . import limits
 from .errors import InputError
 
 
@@ -20,8 +21,10 @@ def require_file(path: str | os.PathLike[str], *, what: str = "file") -> Path:
         raise InputError(f"{what} not found", p)
     if p.is_dir():
         raise InputError(f"is a folder, expected a {what}", p)
-    if p.stat().st_size == 0:
+    size = p.stat().st_size
+    if size == 0:
         raise InputError(f"{what} is empty", p)
+    limits.check("file_mb", size / 1e6, f"{what} is {size / 1e6:,.0f} MB", p)
     return p
 
 
@@ -81,6 +84,14 @@ def read_json(path: str | os.PathLike[str], *, what: str = "JSON file") -> Any:
     except UnicodeDecodeError:
         raise InputError(f"not a text {what} (not UTF-8)", p) from None
     try:
-        return json.loads(text)
+        return json.loads(text, parse_int=_parse_int)
     except json.JSONDecodeError as e:
         raise InputError(f"invalid JSON at line {e.lineno} column {e.colno}: {e.msg}", p) from None
+    except RecursionError:
+        raise InputError("invalid JSON: nested too deeply", p) from None
+
+
+def _parse_int(text: str) -> int | float:
+    # An integer past float range (10^400) would break every float() downstream, and Python refuses to parse
+    # more than 4300 digits; read such numbers as floats (inf), which the readers' finiteness checks refuse.
+    return int(text) if len(text) < 19 else float(text)

@@ -120,7 +120,7 @@ def test_obj_output(tmp_path, meshes):
     [
         ({"edge_length": 0}, "positive"),
         ({"edge_length": 500}, "longer than"),
-        ({"edge_length": 0.001}, "million"),
+        ({"edge_length": 0.001}, "over the limit of 2,000,000"),
         ({"min_angle": 40}, "34"),
     ],
 )

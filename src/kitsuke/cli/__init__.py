@@ -43,6 +43,10 @@ examples:
   kitsuke pose correct clip.mp4 -o fixed.json --plot legs.png --video overlay.mp4
 
 Run `kitsuke <group> --help` for a group's verbs and options.
+
+limits: inputs past a resource limit are refused before the work, naming the limit. Raise one with
+  --limit NAME=VALUE anywhere on the command line (repeatable), or KITSUKE_LIMIT_<NAME>=VALUE. Defaults:
+  {limits}
 """
 
 
@@ -53,11 +57,33 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
+def _limit_defaults() -> str:
+    import dataclasses
+
+    from ..limits import Limits
+
+    return ", ".join(f"{f.name}={getattr(Limits(), f.name):.10g}" for f in dataclasses.fields(Limits))
+
+
+def _split_limits(argv: list[str]) -> tuple[list[str], list[str]]:
+    """Take every `--limit NAME=VALUE` (or `--limit=NAME=VALUE`) out of argv, wherever it is."""
+    rest, limits = [], []
+    it = iter(argv)
+    for a in it:
+        if a == "--limit":
+            limits.append(next(it, ""))
+        elif a.startswith("--limit="):
+            limits.append(a[len("--limit=") :])
+        else:
+            rest.append(a)
+    return rest, limits
+
+
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     parser = _Parser(
         prog="kitsuke",
         description="kitsuke: put garments on 3D people (sketch-based dressing, kimono try-on mirror).",
-        epilog=EPILOG,
+        epilog=EPILOG.format(limits=_limit_defaults()),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     from .. import __version__
@@ -75,6 +101,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
+    argv, limit_args = _split_limits(argv)
     group = next((a for a in argv if not a.startswith("-")), None)
     parser = build_parser(only=group if group in GROUPS else None)
     args = parser.parse_args(argv)
@@ -84,7 +111,11 @@ def main(argv: list[str] | None = None) -> int:
         target.print_help()
         return 2 if args.group is None else 0
     try:
-        return int(args.run(args) or 0)
+        from .. import limits
+
+        changes = dict(limits.parse_limit(a) for a in limit_args)
+        with limits.raised(**changes):
+            return int(args.run(args) or 0)
     except InputError as e:
         print(f"kitsuke: error: {e}", file=sys.stderr)
         return 2

@@ -28,6 +28,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from .. import limits
 from .._files import read_json, write_text_atomic
 from ..errors import InputError
 from .drag import DragSession, MoveStats, ReleaseStats
@@ -58,7 +59,8 @@ class DragStep:
         if self.pins is not None:
             self.pins = _points(self.pins, "pins")
         if self.grab is not None:
-            g = _points([self.grab] if np.ndim(self.grab) == 1 else self.grab, "grab")
+            g = self.grab
+            g = _points([g] if isinstance(g, list | tuple | np.ndarray) and _is_number_list(g) else g, "grab")
             if len(g) != 1:
                 raise InputError(f"grab must be one point [x, y, z], got {len(g)}")
             self.grab = g[0]
@@ -79,6 +81,10 @@ class Drags:
         return len(self.steps)
 
 
+def _is_number_list(value: Any) -> bool:
+    return all(isinstance(x, int | float | np.number) and not isinstance(x, bool) for x in value)
+
+
 def _points(value: Any, what: str) -> np.ndarray:
     if isinstance(value, list | tuple) and len(value) == 0:
         return np.zeros((0, 3))
@@ -91,6 +97,7 @@ def _points(value: Any, what: str) -> np.ndarray:
     bad = ~np.isfinite(arr).all(axis=1)
     if bad.any():
         raise InputError(f"{what}: point {int(np.argmax(bad))} holds NaN or infinity")
+    limits.check("points", len(arr), f"{what} has {len(arr):,} points")
     return np.ascontiguousarray(arr)
 
 
@@ -124,6 +131,7 @@ def drags_from_dict(d: Any) -> Drags:
     meta = d.get("meta", {})
     if not isinstance(meta, dict):
         raise InputError("'meta' must be an object")
+    limits.check("strokes", len(steps), f"the file has {len(steps):,} steps")
     return Drags([_step_from_dict(s, k) for k, s in enumerate(steps)], dict(meta))
 
 

@@ -39,6 +39,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from .. import limits
 from .._files import read_json, write_text_atomic
 from ..errors import InputError
 from ..geometry.mesh import TriMesh
@@ -82,6 +83,7 @@ def _points_array(value: Any, dim: int, what: str) -> np.ndarray:
         raise InputError(f"{what}: point {int(np.argmax(bad))} holds NaN or infinity")
     if len(arr) < 2:
         raise InputError(f"{what}: a stroke needs at least 2 points, got {len(arr)}")
+    limits.check("points", len(arr), f"{what} has {len(arr):,} points")
     return np.ascontiguousarray(arr)
 
 
@@ -326,6 +328,7 @@ def strokes_from_dict(d: Any) -> Strokes:
     meta = d.get("meta", {})
     if not isinstance(meta, dict):
         raise InputError(f"'meta' must be an object, got {_kind(meta)}")
+    limits.check("strokes", len(pairs), f"the file has {len(pairs):,} stroke pairs")
     return Strokes([_pair_from_dict(p, k) for k, p in enumerate(pairs)], target, dict(meta))
 
 

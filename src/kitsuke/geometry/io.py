@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import limits
 from .._files import atomic_path, require_file
 from ..errors import InputError
 from .mesh import TriMesh
@@ -64,6 +65,13 @@ def _load_with_trimesh(p: Path) -> TriMesh:
         raise InputError(f"cannot read as {p.suffix[1:].upper()}: {e}", p) from None
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.vertices) == 0 or len(loaded.faces) == 0:
         raise InputError("holds no triangle mesh (point cloud or empty scene?)", p)
+    limits.check("vertices", len(loaded.vertices), f"the file has {len(loaded.vertices):,} vertices", p)
+    limits.check("triangles", len(loaded.faces), f"the file has {len(loaded.faces):,} triangles", p)
+    faces = np.asarray(loaded.faces)
+    if faces.min() < 0 or faces.max() >= len(loaded.vertices):
+        raise InputError("a face refers to a vertex that does not exist", p)
+    if not np.isfinite(np.asarray(loaded.vertices, dtype=np.float64)).all():
+        raise InputError("vertices have NaN or infinite coordinates", p)
     # glTF splits vertices along UV/normal seams, which opens the surface: if it is open, merge coincident
     # positions so it is one piece again (a closed mesh is left exactly as stored).
     if p.suffix.lower() in (".glb", ".gltf") and not loaded.is_watertight:

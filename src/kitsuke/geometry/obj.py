@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import limits
 from ..errors import InputError
 
 
@@ -76,6 +77,9 @@ def read_obj(path: str | Path) -> ObjData:
         elif tag == "f":
             # Deferred: all faces are parsed at once below (`_plain_triangles`) when they are plain triangles.
             face_lines.append((rest, group, lineno, len(verts), len(uvs)))
+    # Counted before any number is parsed: each face line is at least one triangle.
+    limits.check("vertices", len(verts), f"the file has {len(verts):,} vertices", path)
+    limits.check("triangles", len(face_lines), f"the file has {len(face_lines):,} faces", path)
     parsed = _plain_triangles([f[0] for f in face_lines])
     if parsed is not None:
         tri_v, tri_t = parsed
@@ -89,6 +93,7 @@ def read_obj(path: str | Path) -> ObjData:
                 tris.append((vi[0], vi[k], vi[k + 1]))
                 tri_uv.append((ti[0], ti[k], ti[k + 1]))
                 tri_group.append(grp)
+        limits.check("triangles", len(tris), f"the file's polygons make {len(tris):,} triangles", path)
         tri_v, tri_t = np.array(tris, dtype=np.int64).reshape(-1, 3), np.array(tri_uv, dtype=np.int64).reshape(-1, 3)
     if not verts:
         raise InputError("no vertices (is this an OBJ file?)", path)
@@ -136,6 +141,8 @@ def _face(rest: str, lineno: int, n_v: int, n_t: int, path: Path) -> tuple[list[
                 ti.append(-1)
     except ValueError:
         raise InputError(f"line {lineno}: bad face index in {'f ' + rest!r}", path) from None
+    if max(map(abs, vi + ti)) >= 2**62:
+        raise InputError(f"line {lineno}: face index out of range in {'f ' + rest!r}", path)
     return vi, ti
 
 
@@ -152,7 +159,7 @@ def _plain_triangles(rests: list[str]) -> tuple[np.ndarray, np.ndarray] | None:
         return None
     try:
         cols = np.array(joined.replace("/", " ").split(), dtype=np.int64).reshape(len(tokens), -1)
-    except ValueError:
+    except (ValueError, OverflowError):
         return None
     if cols.shape[1] != slashes + 1 - double or (cols <= 0).any():
         return None  # relative (negative) or zero indices: the line-by-line parser says what is wrong

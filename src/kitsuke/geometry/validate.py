@@ -68,7 +68,10 @@ def clean_mesh(mesh: TriMesh, *, source: str | None = None) -> tuple[TriMesh, Me
         raise InputError("a face refers to a vertex that does not exist", source)
     # Degenerate: a repeated index, or an area negligible against the mesh scale.
     repeated = (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 2] == f[:, 0])
-    scale = float(np.ptp(v, axis=0).max()) or 1.0
+    with np.errstate(over="ignore", invalid="ignore"):
+        scale = float(np.ptp(v, axis=0).max()) or 1.0
+    if not np.isfinite(scale) or scale > 1e150:  # cross products would overflow: no real mesh spans this
+        raise InputError(f"coordinates span {scale:.3g} units, too large for any mesh", source)
     tri = v[f]
     area2 = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
     degenerate = repeated | (area2 <= (1e-12 * scale) ** 2)

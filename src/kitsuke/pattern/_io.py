@@ -25,7 +25,9 @@ def load_pattern_with_issues(path: str | os.PathLike[str]) -> tuple[Pattern, lis
     p = Path(path)
     suffix = p.suffix.lower()
     if suffix == ".svg":
-        return read_svg_with_issues(p)
+        pattern, issues = read_svg_with_issues(p)
+        pattern.source = str(p)
+        return pattern, issues
     if suffix != ".json":
         raise InputError(f"unknown pattern file type {p.suffix or '(none)'!r} (use .json or .svg)", p)
     d = read_json(p, what="pattern file")
@@ -42,6 +44,7 @@ def load_pattern_with_issues(path: str | os.PathLike[str]) -> tuple[Pattern, lis
             raise InputError(f"not a pattern file: neither kitsuke ({FORMAT!r}) nor a GarmentCode specification")
     except InputError as e:
         raise InputError(e.message, p) from None
+    pattern.source = str(p)
     return pattern, check_pattern(pattern, p)
 
 

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import limits
 from .._files import write_text_atomic
 from ..errors import InputError
 from ._layers import LayerRegion, pattern_layers
@@ -184,11 +185,15 @@ def mesh_pattern(pattern: Pattern, *, edge_length: float = 1.5, min_angle: float
     extent = max(float(np.ptp(p.bounds, axis=0).max()) for p in pattern.pieces)
     total = sum(p.area for p in pattern.pieces)
     h = float(edge_length)
-    if total / (0.433 * h * h) > 5_000_000:
-        raise InputError(
-            f"edge length {h:g} cm would make over 5 million triangles for {total:.0f} cm²; choose a longer one",
-            "--edge-length",
-        )
+    # A triangle of edge h covers about 0.433 h²; checked before Triangle allocates anything.
+    estimate = total / (0.433 * h * h)
+    limits.check(
+        "triangles",
+        estimate,
+        f"meshing {total / 1e4:,.4g} m² of cloth at edge length {h:g} cm would make about {estimate:,.0f} triangles "
+        "(a longer --edge-length makes fewer)",
+        pattern.source or "--edge-length",
+    )
     if h > extent:
         raise InputError(f"edge length {h:g} cm is longer than the largest piece ({extent:.1f} cm)", "--edge-length")
     counts = _segments_for(pattern, h)

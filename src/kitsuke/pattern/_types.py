@@ -25,6 +25,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from .. import limits
 from ..errors import InputError
 from . import _geometry as geo
 
@@ -60,7 +61,7 @@ class Curve:
     control: np.ndarray
 
     def __post_init__(self) -> None:
-        if self.type not in geo.CONTROL_COUNT:
+        if not isinstance(self.type, str) or self.type not in geo.CONTROL_COUNT:
             raise InputError(f"unknown curve type {self.type!r} (use quadratic, cubic or circle)")
         k = geo.CONTROL_COUNT[self.type]
         ctrl = _finite_array(self.control, (2,), "curve control")
@@ -204,6 +205,21 @@ class Piece:
             curves[i] = c
         self.curves = dict(sorted(curves.items()))
         self.flipped = bool(self.flipped)
+        self._check_size()
+
+    def _check_size(self) -> None:
+        """Refuse a piece past the size limits before anything samples or meshes it (a 10^9 cm arc would be
+        sampled into billions of points)."""
+        name = f"piece {self.name!r}"
+        for i in range(self.n_edges):
+            length = geo.curve_length_bound(*self._curve_args(i))
+            if not math.isfinite(length):
+                raise InputError(f"{name}: edge {i} has no finite length")
+            limits.check("edge_m", length / 100.0, f"{name}: edge {i} is {length / 100.0:,.4g} m long")
+        area = self.area
+        if not math.isfinite(area):
+            raise InputError(f"{name}: outline has no finite area")
+        limits.check("piece_m2", area / 1e4, f"{name}: its area is {area / 1e4:,.4g} m²")
 
     # -- edges -----------------------------------------------------------------------------------------------
     @property
@@ -333,6 +349,7 @@ class Pattern:
         (x -> -x) against the piece's own: a GarmentCode back panel, which runs clockwise there. Strokes are
         drawn in the file's coordinates (`file_to_piece`); a kitsuke JSON file written from this pattern holds
         the piece's own coordinates, so this is not saved.
+    source : the file it was read from, or None; errors about the pattern as a whole name it.
     """
 
     name: str
@@ -340,6 +357,7 @@ class Pattern:
     seams: list[Seam] = field(default_factory=list)
     meta: dict[str, Any] = field(default_factory=dict)
     file_mirrored: frozenset[str] = field(default_factory=frozenset, compare=False)
+    source: str | None = field(default=None, compare=False)
 
     def file_to_piece(self, piece: str, points: np.ndarray) -> np.ndarray:
         """Points (n, 2) cm in the coordinates of the file the pattern came from -> the piece's own (a copy)."""
@@ -380,4 +398,11 @@ class Pattern:
     def copy(self) -> Pattern:
         import copy as _copy
 
-        return Pattern(self.name, [p.copy() for p in self.pieces], list(self.seams), _copy.deepcopy(self.meta))
+        return Pattern(
+            self.name,
+            [p.copy() for p in self.pieces],
+            list(self.seams),
+            _copy.deepcopy(self.meta),
+            self.file_mirrored,
+            self.source,
+        )

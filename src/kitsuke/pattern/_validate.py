@@ -5,7 +5,8 @@ Errors — a loader refuses the file (InputError naming it) and `validate` lists
   self-intersection (the outline, curves included, crosses or touches itself), clockwise (the outline must run
   counter-clockwise seen from the outer face; reverse it or set `flipped`), unknown-piece, unknown-edge,
   seam-self (an edge sewn to itself), edge-in-two-seams (a seam joins whole edges; split the edge instead),
-  bad-layers (a malformed `meta["layers"]`, see `_layers`).
+  bad-layers (a malformed `meta["layers"]`, see `_layers`), over-limit (more pieces or seams than
+  `kitsuke.limits` allows; a piece past the size limits is refused when it is made).
 Warnings — reported, the pattern loads and meshes:
   length-mismatch (a seam's two edges differ by more than 1 % of the longer one: sewing would stretch or ease
   the cloth; meshing still gives both sides the same number of vertices).
@@ -20,6 +21,7 @@ from typing import Literal
 
 import numpy as np
 
+from .. import limits
 from ..errors import InputError
 from . import _geometry as geo
 from ._layers import pattern_layers
@@ -98,6 +100,11 @@ def _piece_issues(piece) -> list[Issue]:
 def validate(pattern: Pattern) -> list[Issue]:
     """Check a pattern; returns every error and warning found (empty when all is well). Never raises."""
     issues: list[Issue] = []
+    for name, count in (("pieces", len(pattern.pieces)), ("seams", len(pattern.seams))):
+        try:
+            limits.check(name, count, f"pattern has {count:,} {name}")
+        except InputError as e:
+            return [Issue("error", "over-limit", e.message)]  # checked first: the rest would take long
     if not pattern.pieces:
         issues.append(Issue("error", "no-pieces", "pattern has no pieces"))
     counts = Counter(p.name for p in pattern.pieces)

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import limits
 from .._files import require_file
 from ..errors import InputError
 
@@ -190,6 +191,7 @@ def read_bvh(path: str | os.PathLike[str]) -> BvhFile:
         raise InputError(f"Frame Time must be positive, got {frame_time}", p)
     if n <= 0:
         raise InputError("the file has no frames (Frames: 0)", p)
+    limits.check("frames", n, f"the file has {n:,} frames", p)
     data_text = motion_text[m_time.end() :]
     n_ch = sum(len(c) for c in channels)
     try:

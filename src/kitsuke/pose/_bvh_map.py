@@ -371,6 +371,11 @@ def load_bvh(
             put(f"{side}_heel", pos[:, ankle] + np.einsum("nij,j->ni", rot[:, ankle], heel_local))
         derived_feet[side] = toe_derived
 
+    with np.errstate(all="ignore"):
+        bad = ~np.isfinite(out).all(axis=(1, 2))
+    if bad.any():
+        # Finite numbers can still overflow through the offsets and rotations (1e308-sized values).
+        raise InputError(f"frame {int(frames[np.argmax(bad)])}: joint positions overflow (values too large)", path)
     source = {
         "kind": "bvh",
         "path": str(path),

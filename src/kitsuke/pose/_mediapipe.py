@@ -18,6 +18,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from .. import limits
 from .._files import require_file
 from .._progress import progress
 from ..errors import InputError
@@ -217,6 +218,12 @@ def open_video(path: str | os.PathLike[str]) -> tuple[Any, float, int, tuple[int
     size = (int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT)))
     if not (fps > 0 and np.isfinite(fps)):
         fps = 30.0  # containers without a frame rate: assume 30 and say so in the source
+    try:
+        _check_image_size(*size, p)
+        limits.check("frames", n, f"the video declares {n:,} frames", p)
+    except InputError:
+        cap.release()
+        raise
     return cap, fps, n, size
 
 
@@ -287,7 +294,20 @@ def extract_video(
     return PoseSequence(positions=pos, valid=valid, times=times, fps=fps / stride, source=source, image=img)
 
 
+def _check_image_size(width: int, height: int, path: Path) -> None:
+    limits.check("image_mpx", width * height / 1e6, f"the image is {width:,}×{height:,} pixels", path)
+
+
 def _read_image(path: Path) -> np.ndarray:
+    try:  # the header's size, before decoding a picture that would not fit in memory
+        from PIL import Image
+
+        with Image.open(path) as im:
+            size = im.size
+    except Exception:  # noqa: BLE001 - not an image Pillow knows: OpenCV decides below
+        size = None
+    if size is not None:
+        _check_image_size(*size, path)
     cv2 = _cv2()
     data = np.fromfile(str(path), dtype=np.uint8)
     bgr = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
@@ -356,10 +376,12 @@ def _read_size(path: Path) -> tuple[int, int]:
         from PIL import Image
 
         with Image.open(path) as im:
-            return im.size
+            size = im.size
     except Exception:  # noqa: BLE001 - fall back to a full decode, which raises InputError if unreadable
         bgr = _read_image(path)
         return bgr.shape[1], bgr.shape[0]
+    _check_image_size(*size, path)
+    return size
 
 
 def extract_camera(

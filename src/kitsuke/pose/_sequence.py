@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import limits
 from .._files import read_json, write_json_atomic
 from ..errors import InputError
 from ..skeleton import INDEX, JOINTS
@@ -222,6 +223,7 @@ def poses_from_json(doc: Any, path: str | os.PathLike[str] = "<poses>") -> PoseS
     frames = doc.get("frames")
     if not isinstance(frames, list) or not frames:
         raise InputError("frames must be a non-empty list", p)
+    limits.check("frames", len(frames), f"the file has {len(frames):,} frames", p)
     source = doc.get("source", {})
     if not isinstance(source, dict):
         raise InputError("source must be an object", p)

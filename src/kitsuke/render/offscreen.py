@@ -13,6 +13,7 @@ from typing import Literal
 
 import numpy as np
 
+from .. import limits
 from .._files import atomic_path, check_output, require_file
 from ..errors import InputError
 from ..geometry import TriMesh
@@ -369,9 +370,14 @@ def read_texture(path: str | os.PathLike[str]) -> np.ndarray:
     p = require_file(path, what="texture image")
     try:
         with Image.open(p) as im:
+            w, h = im.size
+            limits.check("image_mpx", w * h / 1e6, f"the image is {w:,}×{h:,} pixels", p)
             im = im.convert("RGBA" if im.mode in ("RGBA", "LA", "PA") else "RGB")
             return np.asarray(im, dtype=np.uint8)
-    except (UnidentifiedImageError, OSError) as e:
+    except InputError:
+        raise
+    except (UnidentifiedImageError, OSError, Image.DecompressionBombError, ValueError, SyntaxError) as e:
+        # Pillow's decoders raise these for corrupt data (SyntaxError for some broken headers).
         raise InputError(f"not a readable image ({e.__class__.__name__})", p) from None
 
 
