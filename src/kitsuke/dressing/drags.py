@@ -64,7 +64,7 @@ class DragStep:
             if len(g) != 1:
                 raise InputError(f"grab must be one point [x, y, z], got {len(g)}")
             self.grab = g[0]
-        self.path = _points(self.path, "path") if len(self.path) else np.zeros((0, 3))
+        self.path = _points(self.path, "path")
         if len(self.path) and self.grab is None:
             raise InputError("a path needs a grab (the point of the garment that moves along it)")
 

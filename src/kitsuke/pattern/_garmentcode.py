@@ -211,7 +211,7 @@ def garmentcode_from_dict(d: Any, *, name: str = "garment") -> Pattern:
     if not isinstance(panels, dict) or not panels:
         raise InputError("pattern.panels must be a non-empty object")
     order = d["pattern"].get("panel_order")
-    names = [n for n in order if n in panels] if isinstance(order, list) else []
+    names = [n for n in order if isinstance(n, str) and n in panels] if isinstance(order, list) else []
     names += [n for n in panels if n not in names]
     notes: list[str] = []
     pieces, edge_maps = [], {}

@@ -152,15 +152,63 @@ def _piece(name: str, edges: list) -> Piece:
     return Piece(name, outline - origin, curves)
 
 
+#: Elements an SVG may expand to through <use> (a pattern has a few hundred; a <use> chain can multiply them).
+MAX_EXPANDED_ELEMENTS = 100_000
+
+
+def _check_structure(path: Path) -> None:
+    """Refuse, before svgelements expands them, <use> references that form a cycle (an element used inside
+    itself: svgelements would expand it forever) or that multiply the document past MAX_EXPANDED_ELEMENTS."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as e:
+        raise InputError(f"not a readable SVG file (XML: {e})", path) from None
+    except RecursionError:
+        raise InputError("not a readable SVG file (nested too deeply)", path) from None
+    ids = {e.get("id"): e for e in root.iter() if e.get("id")}
+    counts: dict[int, int] = {}
+
+    def expanded(element, active: set[int]) -> int:
+        key = id(element)
+        if key in counts:
+            return counts[key]
+        if key in active:
+            raise InputError(f"<use> elements form a cycle through #{element.get('id')}", path)
+        active.add(key)
+        n = 1
+        for child in element:
+            n += expanded(child, active)
+        if element.tag.rsplit("}", 1)[-1] == "use":
+            href = element.get("{http://www.w3.org/1999/xlink}href") or element.get("href") or ""
+            target = ids.get(href[1:]) if href.startswith("#") else None
+            if target is not None:
+                n += expanded(target, active)
+        active.discard(key)
+        if n > MAX_EXPANDED_ELEMENTS:
+            raise InputError(f"<use> elements expand the document past {MAX_EXPANDED_ELEMENTS:,} elements", path)
+        counts[key] = n
+        return n
+
+    try:
+        expanded(root, set())
+    except RecursionError:
+        raise InputError("not a readable SVG file (nested too deeply)", path) from None
+
+
 def svg_to_pattern(path: str | os.PathLike[str]) -> Pattern:
     """Parse an SVG file into a Pattern without validating it (see `read_svg`)."""
     import svgelements as se
 
     p = require_file(path, what="SVG file")
+    _check_structure(p)
     try:
         svg = se.SVG.parse(str(p), reify=True, ppi=96.0)
     except Exception as e:  # noqa: BLE001 - the XML parser raises several types; all mean "not a readable SVG"
         raise InputError(f"not a readable SVG file ({type(e).__name__}: {e})", p) from None
+    if not isinstance(svg, se.Group):
+        raise InputError("not an SVG document (no <svg> root element)", p)
     shapes: list = []
     _walk(svg, (), shapes)
     freesewing = any(_tokens(s) & MATERIAL_CLASSES for s, _ in shapes)

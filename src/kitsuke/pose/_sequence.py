@@ -201,7 +201,7 @@ def poses_from_json(doc: Any, path: str | os.PathLike[str] = "<poses>") -> PoseS
         raise InputError(f"unsupported {FORMAT} version {doc.get('version')!r}; this kitsuke reads {VERSION}", p)
     if doc.get("units", "m") != "m":
         raise InputError(f'units must be "m", got {doc.get("units")!r}', p)
-    if list(doc.get("up", [0, 1, 0])) != [0, 1, 0]:
+    if doc.get("up", [0, 1, 0]) != [0, 1, 0]:
         raise InputError(f"up must be [0, 1, 0] (Y up), got {doc.get('up')!r}", p)
     fps = doc.get("fps")
     if not _number(fps) or not (math.isfinite(fps) and fps > 0):
