@@ -62,6 +62,12 @@ def _read_strokes(path: Path) -> None:
     resolve_strokes(read_strokes(path), pattern, surface, pattern_mesh=mesh)
 
 
+def _read_garment(path: Path) -> None:
+    from kitsuke.dressing.export import read_garment_obj
+
+    read_garment_obj(path)
+
+
 def _read_drags(path: Path) -> None:
     from kitsuke.dressing import read_drags
 
@@ -115,6 +121,28 @@ def _kimono_json() -> bytes:
 
     with tempfile.TemporaryDirectory() as d:
         return save_pattern(default_kimono(), Path(d) / "kimono.json").read_bytes()
+
+
+def _garment_obj() -> bytes:
+    """A garment OBJ as `kitsuke dress --obj` writes it (pieces, a layer, the contact offset): the kimono's pieces
+    at their placement, meshed coarsely (the reader's work does not depend on a wrap)."""
+    from kitsuke.dressing.export import GarmentFile, garment_obj_text
+    from kitsuke.pattern import default_kimono, mesh_pattern
+
+    mesh = mesh_pattern(default_kimono(), edge_length=8.0)
+    layer = np.zeros(len(mesh.faces), np.int8)
+    layer[mesh.piece_faces[1, 0] : mesh.piece_faces[1, 1]] = 1
+    garment = GarmentFile(
+        mesh.positions_m,
+        mesh.faces,
+        mesh.vertices_cm[mesh.faces] / 100.0,
+        list(mesh.piece_names),
+        mesh.piece_faces,
+        "kimono",
+        layer,
+        0.003,
+    )
+    return garment_obj_text(garment).encode()
 
 
 def _packaged(*parts: str) -> bytes:
@@ -193,6 +221,7 @@ TARGETS: dict[str, Target] = {
         Target("body-glb", ".glb", "binary", _read_body, lambda: [_mesh_bytes(".glb")]),
         Target("body-ply", ".ply", "binary", _read_body, lambda: [_mesh_bytes(".ply")]),
         Target("strokes", ".json", "json", _read_strokes, lambda: [_packaged("strokes", "kimono_default.json")]),
+        Target("garment-obj", ".obj", "text", _read_garment, lambda: [_garment_obj()]),
         Target("drags", ".json", "json", _read_drags, lambda: [_drags_json()]),
         Target("poses", ".json", "json", _read_poses, lambda: [_poses_json()]),
         Target("bvh", ".bvh", "text", _read_bvh, lambda: [_bvh_text()]),
@@ -274,8 +303,8 @@ def _get(doc, path):
 
 def mutate_json(seed: bytes, ops: list[tuple[str, int, object]]) -> bytes:
     """Apply structure-aware operations to a JSON document. Each op is (action, which node, value):
-    replace the node by value, delete it, add an extra key, duplicate or drop list items, rename a key to a
-    duplicate, or wrap the node in a list. Numbers like NaN and 10^400 go out as JSON spells them (NaN, Infinity,
+    replace the node by value, delete it, add an extra key, duplicate (e.g. a piece: duplicate names), drop or
+    swap list items (outline points: self-intersections), copy a value under another key, or wrap it in a list. Numbers like NaN and 10^400 go out as JSON spells them (NaN, Infinity,
     a 400-digit integer)."""
     doc = json.loads(seed)
     for action, which, value in ops:
@@ -303,13 +332,16 @@ def mutate_json(seed: bytes, ops: list[tuple[str, int, object]]) -> bytes:
                 parent[others[which % len(others)]] = node
         elif action == "wrap":
             parent[key] = [node]
+        elif action == "swap" and isinstance(node, list) and len(node) > 1:
+            i, j = which % len(node), (which // len(node)) % len(node)
+            node[i], node[j] = node[j], node[i]  # outline points swapped: a self-intersecting outline
         elif action == "scale" and isinstance(node, int | float) and not isinstance(node, bool):
             factor = value if isinstance(value, float) else 1e6
             parent[key] = node * factor if math.isfinite(node * factor) else factor
     return json.dumps(doc, allow_nan=True).encode()
 
 
-JSON_ACTIONS = ("replace", "delete", "extra", "duplicate", "truncate", "rename", "wrap", "scale")
+JSON_ACTIONS = ("replace", "delete", "extra", "duplicate", "truncate", "rename", "wrap", "scale", "swap")
 
 _NUMBER = re.compile(rb"-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
 

@@ -23,6 +23,8 @@ def _valid(kind: str) -> tuple[str, bytes]:
     """(suffix, bytes) of a valid input of each kind the commands take."""
     if kind == "video":
         return ".mp4", (DATA / "pose" / "pose2sim_static_tpose_cam01.mp4").read_bytes()
+    if kind == "image":
+        return ".png", _png()
     target = {
         "body": "body-obj",
         "pattern": "pattern-kitsuke",
@@ -34,6 +36,17 @@ def _valid(kind: str) -> tuple[str, bytes]:
         "garment": "body-obj",
     }[kind]
     return TARGETS[target].suffix, seeds(target)[0]
+
+
+def _png() -> bytes:
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray(np.full((64, 48, 3), 200, np.uint8)).save(buf, format="PNG")
+    return buf.getvalue()
 
 
 def _wrong_format(kind: str) -> bytes:
@@ -74,6 +87,8 @@ COMMANDS = [
     ("pose extract {bvh} -o {out}.json", "bvh"),
     ("pose extract {poses} -o {out}.json", "poses"),
     ("pose extract {video} -o {out}.json", "video"),
+    ("pose extract {image} -o {out}.json", "image"),
+    ("render default --texture {image} -o {out}.png", "image"),
     ("pose correct {poses} -o {out}.json --constraints {constraints}", "constraints"),
 ]
 
@@ -82,7 +97,7 @@ COMMANDS = [
 @pytest.mark.parametrize(("command", "slot"), COMMANDS, ids=[f"{c.split(' {')[0]}-{s}" for c, s in COMMANDS])
 def test_corrupt_input(command, slot, corruption, tmp_path, run_cli):
     files = {}
-    for kind in ("body", "pattern", "strokes", "drags", "bvh", "poses", "constraints", "garment", "video"):
+    for kind in ("body", "pattern", "strokes", "drags", "bvh", "poses", "constraints", "garment", "video", "image"):
         if "{" + kind + "}" not in command:
             continue
         suffix, data = _valid(kind)

@@ -15,7 +15,7 @@ from .strategies import cases, seeds
 
 pytestmark = pytest.mark.slow
 
-EXAMPLES = 25
+EXAMPLES = 50
 
 
 @pytest.fixture(scope="module")

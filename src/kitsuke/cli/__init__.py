@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import signal
 import sys
 import traceback
 
@@ -55,6 +56,22 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> None:  # type: ignore[override]
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+class _Terminated(BaseException):
+    """SIGTERM, raised where the program is so that every atomic write in progress removes its temporary file."""
+
+
+def _on_terminate():
+    """Turn SIGTERM into `_Terminated` (from the main thread only); returns the previous handler, or None."""
+
+    def handler(signum, frame):
+        raise _Terminated
+
+    try:
+        return signal.signal(signal.SIGTERM, handler)
+    except ValueError:  # not the main thread: leave signals alone
+        return None
 
 
 def _limit_defaults() -> str:
@@ -110,12 +127,16 @@ def main(argv: list[str] | None = None) -> int:
         target = parser if args.group is None else parser._subparsers._group_actions[0].choices[args.group]  # type: ignore[union-attr]
         target.print_help()
         return 2 if args.group is None else 0
+    previous = _on_terminate()
     try:
         from .. import limits
 
         changes = dict(limits.parse_limit(a) for a in limit_args)
         with limits.raised(**changes):
             return int(args.run(args) or 0)
+    except _Terminated:
+        print("kitsuke: terminated", file=sys.stderr)
+        return 143
     except InputError as e:
         print(f"kitsuke: error: {e}", file=sys.stderr)
         return 2
@@ -133,6 +154,9 @@ def main(argv: list[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 1
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

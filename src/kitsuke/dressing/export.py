@@ -110,10 +110,13 @@ def read_garment_obj(path: str | os.PathLike[str]) -> GarmentFile:
         elif line.startswith(PIECE_TAG + " "):
             try:
                 name, first, last = line[len(PIECE_TAG) + 1 :].rsplit(" ", 2)
-                names.append(name)
-                ranges.append((int(first), int(last) + 1))
+                first, last = int(first), int(last)
             except ValueError:
                 raise InputError(f"bad piece line {line!r}", path) from None
+            if not 0 <= first <= last < len(data.faces):
+                raise InputError(f"piece line {line!r}: names faces the file does not have", path)
+            names.append(name)
+            ranges.append((first, last + 1))
         elif line.startswith(LAYER_TAG + " "):
             try:
                 value, first, last = (int(v) for v in line[len(LAYER_TAG) + 1 :].split())
@@ -132,8 +135,6 @@ def read_garment_obj(path: str | os.PathLike[str]) -> GarmentFile:
     if not names:
         names, ranges = ["garment"], [(0, len(data.faces))]
     piece_faces = np.array(ranges, dtype=np.int64)
-    if piece_faces.min() < 0 or piece_faces.max() > len(data.faces):
-        raise InputError("a piece line names faces the file does not have", path)
     return GarmentFile(
         data.vertices,
         data.faces,
