@@ -28,7 +28,6 @@ from tests.fuzz.harness import TARGETS, Worker  # noqa: E402
 def fuzz_target(target: str, n: int, keep: str | None, seed: int) -> dict:
     from hypothesis import HealthCheck, Phase, given, settings
     from hypothesis import seed as hypothesis_seed
-
     from tests.fuzz.strategies import cases
 
     worker = Worker()

@@ -304,8 +304,8 @@ def _get(doc, path):
 def mutate_json(seed: bytes, ops: list[tuple[str, int, object]]) -> bytes:
     """Apply structure-aware operations to a JSON document. Each op is (action, which node, value):
     replace the node by value, delete it, add an extra key, duplicate (e.g. a piece: duplicate names), drop or
-    swap list items (outline points: self-intersections), copy a value under another key, or wrap it in a list. Numbers like NaN and 10^400 go out as JSON spells them (NaN, Infinity,
-    a 400-digit integer)."""
+    swap list items (outline points: self-intersections), copy a value under another key, or wrap it in a list.
+    Numbers like NaN and 10^400 go out as JSON spells them (NaN, Infinity, a 400-digit integer)."""
     doc = json.loads(seed)
     for action, which, value in ops:
         nodes = list(_paths(doc))

@@ -163,8 +163,8 @@ def _check_structure(path: Path) -> None:
 
     try:
         root = ET.parse(path).getroot()
-    except ET.ParseError as e:
-        raise InputError(f"not a readable SVG file (XML: {e})", path) from None
+    except (ET.ParseError, LookupError, ValueError) as e:  # LookupError: an unknown encoding in the XML header
+        raise InputError(f"not a readable SVG file ({type(e).__name__}: {e})", path) from None
     except RecursionError:
         raise InputError("not a readable SVG file (nested too deeply)", path) from None
     ids = {e.get("id"): e for e in root.iter() if e.get("id")}
