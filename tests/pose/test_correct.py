@@ -142,7 +142,7 @@ def test_out_of_reach_is_reported_not_crashed():
 
 def test_numba_kernel_matches_numpy_reference(balancing_raw, kick):
     for poses in (balancing_raw, kick.subset(slice(120, 200))):
-        c = correct_poses(poses)
+        c = correct_poses(poses, max_jump_m=np.inf, side_margin_m=np.inf)
         ref, targets = correct_reference(poses.positions, poses.valid, TABLE)
         v = poses.valid
         assert np.array_equal(np.where(c.rotated, c.target, -1), targets)
@@ -165,9 +165,10 @@ def test_real_sequences_keep_all_invariants(which, balancing_raw, kick):
     if which.startswith("balancing"):
         assert inv["ok"], inv  # continuity too
     else:
-        # The kick: where the farther leg is already inside K' the other leg becomes the target (no spike); that
-        # switch can break the SPEC's continuity bound once (measured: 1 of 111 checks, 11.7 mm; see test_walk_...).
-        assert inv["continuity_broken"] <= 0.02 * inv["continuity_checked"] and inv["worst_continuity_excess_m"] < 0.02
+        # The kick: the target leg is kept from frame to frame (no snap of the other leg), and where the farther leg
+        # is already inside K' the other one is the target; either can break the SPEC's continuity bound by a few
+        # millimetres (measured 2026-11-26: 4 of 80 checks, 2.8 mm at worst; 0 on the horizontal motion).
+        assert inv["continuity_broken"] <= 0.06 * inv["continuity_checked"] and inv["worst_continuity_excess_m"] < 0.01
     m = correction_measures(c)
     if which.startswith("balancing"):
         # large leg raises: frames must be corrected there, knees and ankles
@@ -175,7 +176,8 @@ def test_real_sequences_keep_all_invariants(which, balancing_raw, kick):
         assert m["residual_mm"]["max"] == 0.0
     else:
         assert m["corrections"]["knee"] > 30  # the kick
-        assert inv["unreachable"] <= 10
+        # out of reach, or reachable only by swapping sides or jumping (measured 2026-11-26: 47 of 402)
+        assert inv["unreachable"] <= 60
 
 
 def test_walk_invariants(walk):
@@ -218,3 +220,59 @@ def test_invalid_frames_pass_through():
     c = correct_poses(s)
     assert np.isnan(c.poses.positions[1]).all() and (c.status[1] == K.INVALID).all()
     assert c.rotated[2, 0]
+
+
+# -- plausibility: legs held by a kimono still look like legs ------------------------------------------------------
+def knee_raise(frames: int = 40, top_deg: float = 100.0) -> np.ndarray:
+    """(frames, 23, 3): the right thigh raised forward from 0 to `top_deg` and back down, the left leg standing."""
+    stand = standing_pose()
+    deg = top_deg * np.sin(np.linspace(0.0, np.pi, frames))
+    return np.stack([raise_leg(stand, "r", "x", d) for d in deg])
+
+
+@pytest.mark.parametrize("case", ["knee_raise", "side_kick", "front_kick"])
+def test_corrected_legs_keep_their_side_and_do_not_jump(case):
+    stand = standing_pose()
+    if case == "knee_raise":
+        frames = knee_raise()
+    elif case == "side_kick":
+        frames = np.stack([raise_leg(stand, "l", "z", d) for d in 70 * np.sin(np.linspace(0, np.pi, 30))])
+    else:  # the straight left leg swung forward to 80 degrees and back in half a second (16 frames at 30 fps;
+        # in 12 frames one transition jumps 31 cm past the allowance: no rotation of the shin can follow)
+        frames = np.stack([raise_leg(stand, "l", "x", d) for d in 80 * np.sin(np.linspace(0, np.pi, 16))])
+    c = correct_poses(seq(list(frames)))
+    inv = check_invariants(c)
+    assert c.rotated.any(), "the case must need a correction"
+    assert inv["sides_swapped"] == 0 and inv["jumps_over_limit"] == 0, inv
+    assert inv["untouched_changed"] == 0 and inv["targets_outside"] == 0 and inv["lengths_changed"] == 0, inv
+
+
+def test_without_the_rules_the_knee_raise_swaps_or_jumps():
+    """The rules are what keeps the legs plausible: the SPEC's bare rotation breaks them on the same motion."""
+    c = correct_poses(seq(list(knee_raise())), max_jump_m=np.inf, side_margin_m=np.inf)
+    inv = check_invariants(c)
+    assert inv["sides_swapped"] > 0 or inv["jumps_over_limit"] > 0, inv
+
+
+@pytest.mark.parametrize("which", ["balancing", "kick", "walk"])
+def test_real_sequences_keep_sides_and_mostly_do_not_jump(which, balancing_raw, kick, walk):
+    poses = {"balancing": balancing_raw, "kick": kick, "walk": walk}[which]
+    c = correct_poses(poses)
+    inv = check_invariants(c)
+    assert inv["sides_swapped"] == 0, inv
+    if which == "balancing":
+        assert inv["jumps_over_limit"] == 0, inv
+    else:
+        # Mocap at full kicks and strides: where no rotation of the thigh or shin keeps every joint of the chain
+        # within 5 cm of its last place, the one that jumps least is taken (measured 2026-11-26: kick 4 of 200
+        # transitions, worst 18.8 cm beyond the allowance; walk 14 of 993, 7.8 cm).
+        assert inv["jumps_over_limit"] <= 0.03 * poses.n_frames and inv["worst_jump_excess_m"] < 0.25, inv
+
+
+def test_summary_reports_own_frame_exceedance(balancing_raw):
+    m = correction_measures(correct_poses(balancing_raw))
+    for pair in ("knee", "ankle"):
+        e = m["exceeds_own_limit"][pair]
+        assert set(e) == {"frames", "max_cm", "mean_cm"} and 0 <= e["mean_cm"] <= e["max_cm"]
+    assert m["residual_mm"]["max"] == 0.0  # rotated into K' means inside K'
+    assert m["short_of_region"]["frames"] >= 0

@@ -13,6 +13,25 @@ For each frame, in order, knees first and then ankles (on the knee-corrected pos
    the target toward its closest point on K''s ellipse (up × w when the segment is parallel to w), by the smallest
    angle in (0°, 180°] that puts the target inside the vertical cylinder through K' (sampled, then bisected to
    0.1 mm of target motion); if no angle does, by the angle that comes closest.
+
+Plausibility rules (where the SPEC is silent; without them a knee raise swaps the ankles' sides, draws the right
+leg to the left foot and snaps a knee 26 cm between frames):
+4. Which joint: the leg rotated in the previous frame stays the target while the pair needs correcting. Switching
+   legs would drop the other leg's correction in one frame (its whole size as a jump).
+5. Which angle: only angles that keep every moved leg joint on its raw side of the sagittal plane (through the
+   pelvis, normal along the hip axis; within `SIDE_MARGIN_M`) and keep the target within its raw motion plus
+   `MAX_JUMP_M` of its previous corrected place (the ankle pass checks the ankle, heel and toe; the knee pass the
+   knee, since the ankle pass can still turn the shin) count. The smallest such angle that reaches K' is taken
+   (status "rotated into K'", or CONSTRAINED when a smaller angle reached K' but broke a rule); if none reaches
+   it, the allowed angle closest to K' (LIMITED), or, when no angle about this frame's axis is allowed, the part
+   of the turn back toward the previous frame's segment direction that jumps least.
+6. Easing out: a frame that needs no rotation, yet where dropping the previous frame's correction (or the knee
+   pass's move of the shin) at once would jump past the allowance, turns the segment toward the previous
+   frame's direction by the smallest part that keeps within it (EASED). So a correction fades over a few frames
+   instead of snapping back. Both legs are checked, also in a frame that rotates the other one.
+The SPEC's invariants hold as before, with frames touched by the rules counted as touched; its continuity bound
+assumes the smallest angle and is checked where that was taken. `correct_poses(..., max_jump_m=inf,
+side_margin_m=inf)` is the SPEC's rotation alone (with rule 4).
 """
 
 from __future__ import annotations
@@ -63,7 +82,15 @@ STATUS = {
     K.ALREADY_INSIDE: "both joints already inside K'",
     K.CLOSEST: "rotated to the closest angle (K' out of reach)",
     K.UNREACHABLE: "K' out of reach, not rotated",
+    K.CONSTRAINED: "rotated into K' by a larger angle (the smallest would swap sides or jump)",
+    K.LIMITED: "rotated toward K' as far as the side and jump rules allow",
+    K.EASED: "inside, part of the previous frame's rotation kept (no jump)",
 }
+#: A moved joint may move this much more than its raw motion between consecutive frames, metres.
+MAX_JUMP_M = 0.05
+#: A leg joint counts as on the other side of the sagittal plane only beyond this, metres: feet walk close to the
+#: plane, and a raw joint a few millimetres from it has no side worth keeping.
+SIDE_MARGIN_M = 0.02
 
 
 @dataclass
@@ -96,7 +123,7 @@ class Correction:
     @property
     def rotated(self) -> np.ndarray:
         """(n, 2) bool: a segment was rotated for this frame and pair."""
-        return (self.status == K.ROTATED) | (self.status == K.CLOSEST)
+        return np.isin(self.status, K.ROTATING)
 
 
 def _tables(constraints: ConstraintTable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -119,6 +146,8 @@ def correct_poses(
     *,
     tolerance_m: float = 1e-4,
     samples: int = 64,
+    max_jump_m: float = MAX_JUMP_M,
+    side_margin_m: float = SIDE_MARGIN_M,
 ) -> Correction:
     """Correct a pose sequence for a kimono (SPEC §5.3); the input is not modified.
 
@@ -128,6 +157,9 @@ def correct_poses(
     constraints : E and A per pair; default the shipped geometric estimate (`default_constraints()`).
     tolerance_m : bisection stops when the target moves less than this between the bracket's ends, metres.
     samples : angles sampled over (0°, 180°] to bracket the smallest one.
+    max_jump_m : a rotated joint may move at most its raw motion plus this between consecutive frames, metres.
+    side_margin_m : a rotated leg joint may end at most this far on the other side of the sagittal plane than its
+        raw position, metres. `inf` for both gives the SPEC's rotation without the plausibility rules.
     """
     if not (tolerance_m > 0):
         raise ValueError(f"tolerance_m must be positive, got {tolerance_m}")
@@ -144,6 +176,7 @@ def correct_poses(
     regions = np.full((n, 2, 6), np.nan)
     status = np.full((n, 2), K.INVALID, dtype=np.int8)
     stage_input = np.full((n, 2, 3), np.nan)
+    axes = np.zeros((n, 2, 3))
     args = (
         pos,
         np.ascontiguousarray(poses.valid),
@@ -158,11 +191,13 @@ def correct_poses(
         INDEX["pelvis"],
         float(tolerance_m),
         int(samples),
+        float(max_jump_m),
+        float(side_margin_m),
     )
     t0 = time.perf_counter()
-    K.correct_frames(*args, out, target, angle, residual, regions, status, stage_input)
+    K.correct_frames(*args, out, target, angle, residual, regions, status, stage_input, axes)
     seconds = time.perf_counter() - t0
-    rotated = (status == K.ROTATED) | (status == K.CLOSEST)
+    rotated = np.isin(status, K.ROTATING)
     corrected = [tuple(JOINTS[target[f, p]] for p in range(2) if rotated[f, p]) for f in range(n)]
     src = dict(poses.source)
     result = replace(
@@ -270,7 +305,9 @@ def check_invariants(
     touched = rotated.any(axis=1)
     same = np.array([np.array_equal(q[f], p[f], equal_nan=True) for f in range(n)])
     untouched_changed = int((~touched & ~same).sum())
-    reach_fail = (c.status == K.CLOSEST) | (c.status == K.UNREACHABLE)
+    # Out of reach, or reached only by a larger angle than the smallest: the SPEC's continuity argument assumes the
+    # smallest angle, so these frames are left out of that check (the side and jump rules bound them instead).
+    reach_fail = np.isin(c.status, (K.CLOSEST, K.UNREACHABLE, K.CONSTRAINED, K.LIMITED, K.EASED))
 
     targets_outside = 0
     continuity_broken = 0
@@ -285,7 +322,7 @@ def check_invariants(
         ell_prev[1:] = regions_of(q[:-1], table, name)[0]
         use_stored = ~prev_ok & rotated[:, pi]
         ell_prev[use_stored] = c.regions[use_stored, pi]
-        sel = np.flatnonzero(c.status[:, pi] == K.ROTATED)
+        sel = np.flatnonzero(np.isin(c.status[:, pi], (K.ROTATED, K.CONSTRAINED)))
         if len(sel):
             tj = c.target[sel, pi]
             g = inside_values(q[sel, tj][:, ::2], ell_prev[sel])
@@ -304,6 +341,7 @@ def check_invariants(
             continuity_broken += int((excess > motion_tol_m).sum())
             continuity_broken_h += int((excess_h > motion_tol_m).sum())
             worst_excess = max(worst_excess, float(excess.max()))
+    swapped, jumps, worst_jump = plausibility(q, p, valid)
     bones = np.array([[INDEX[a], INDEX[b]] for a, b in BONES])
     if valid.any():
         len_q = np.linalg.norm(q[valid][:, bones[:, 1]] - q[valid][:, bones[:, 0]], axis=2)
@@ -313,7 +351,12 @@ def check_invariants(
     else:
         dlen, lengths_changed = 0.0, 0
     return {
-        "ok": untouched_changed == 0 and targets_outside == 0 and lengths_changed == 0 and continuity_broken == 0,
+        "ok": untouched_changed == 0
+        and targets_outside == 0
+        and lengths_changed == 0
+        and continuity_broken == 0
+        and swapped == 0
+        and jumps == 0,
         "untouched_changed": untouched_changed,
         "targets_outside": targets_outside,
         "lengths_changed": lengths_changed,
@@ -322,8 +365,40 @@ def check_invariants(
         "continuity_broken": continuity_broken,
         "continuity_broken_horizontal": continuity_broken_h,
         "worst_continuity_excess_m": max(0.0, worst_excess),
-        "unreachable": int(reach_fail.sum()),
+        "unreachable": int(np.isin(c.status, (K.CLOSEST, K.UNREACHABLE, K.LIMITED)).sum()),
+        "constrained": int((c.status == K.CONSTRAINED).sum()),
+        "sides_swapped": swapped,
+        "jumps_over_limit": jumps,
+        "worst_jump_excess_m": worst_jump,
     }
+
+
+_LEG_JOINTS = np.array([INDEX[j] for j in JOINTS if j[2:] in ("knee", "ankle", "heel", "toe")])
+
+
+def plausibility(
+    positions: np.ndarray, raw: np.ndarray, valid: np.ndarray, *, max_jump_m: float = MAX_JUMP_M, tol_m: float = 1e-9
+) -> tuple[int, int, float]:
+    """The corrections' plausibility (issue: legs held by a kimono still look like legs).
+
+    Returns (frames where a corrected leg joint is more than SIDE_MARGIN_M on the other side of the sagittal
+    plane — through the pelvis, normal along the hip axis — than its raw position; frame transitions where a joint
+    moves more than its raw motion plus `max_jump_m`; the largest such excess, metres, 0 when none).
+    """
+    pel = raw[:, INDEX["pelvis"], ::2]
+    n = raw[:, INDEX["l_hip"], ::2] - raw[:, INDEX["r_hip"], ::2]
+    n = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
+    side_raw = ((raw[:, _LEG_JOINTS, ::2] - pel[:, None]) * n[:, None]).sum(-1)
+    side_now = ((positions[:, _LEG_JOINTS, ::2] - pel[:, None]) * n[:, None]).sum(-1)
+    crossed = (side_raw * side_now < 0) & (np.abs(side_now) > SIDE_MARGIN_M)
+    swapped = int((crossed.any(axis=1) & valid).sum())
+    ok = valid[1:] & valid[:-1]
+    if not ok.any():
+        return swapped, 0, 0.0
+    moved_now = np.linalg.norm(np.diff(positions, axis=0), axis=2)[ok]
+    moved_raw = np.linalg.norm(np.diff(raw, axis=0), axis=2)[ok]
+    excess = (moved_now - moved_raw - max_jump_m).max(axis=1)
+    return swapped, int((excess > tol_m).sum()), max(0.0, float(excess.max()))
 
 
 def _max_jumps(positions: np.ndarray, valid: np.ndarray) -> np.ndarray:
@@ -335,11 +410,30 @@ def _max_jumps(positions: np.ndarray, valid: np.ndarray) -> np.ndarray:
     return d.max(axis=0)
 
 
+def exceedance(poses: PoseSequence) -> dict[str, dict[str, float]]:
+    """Per pair, how the corrected pose still exceeds E(θ) of its own frame (the correction aims at K' of the
+    previous frame, so a pair can end inside K' yet apart by more than this frame's E): frames, and the largest and
+    mean excess over those frames, cm."""
+    out = {}
+    v = poses.valid
+    for name in PAIRS:
+        _, excess = regions_of(poses.positions[v], poses.constraints, name)
+        over = excess[excess > 1e-6]
+        out[name] = {
+            "frames": int(len(over)),
+            "max_cm": round(float(over.max()) * 100, 2) if len(over) else 0.0,
+            "mean_cm": round(float(over.mean()) * 100, 2) if len(over) else 0.0,
+        }
+    return out
+
+
 def correction_measures(correction: Correction) -> dict[str, Any]:
     """SPEC §6 pose-correction measures as a JSON-ready dict.
 
-    fraction of valid frames corrected, corrections per pair, residual outside distance of the targets (mm, 0
-    expected), the largest frame-to-frame jump of each leg joint raw vs corrected (m), the time per frame, and the
+    fraction of valid frames corrected, corrections per pair, residual outside distance of the targets rotated into
+    K' (mm, 0 expected), how far short of K' the targets stayed where it was out of reach or only reachable by
+    breaking the side and jump rules (`short_of_region`), how far pairs still exceed E(θ) of their own frame
+    (`exceedance`), the largest frame-to-frame jump of each leg joint raw vs corrected (m), the time per frame, and the
     invariant check (`check_invariants`).
     """
     c = correction
@@ -348,7 +442,10 @@ def correction_measures(correction: Correction) -> dict[str, Any]:
     n_valid = int(valid.sum())
     rotated = c.rotated
     frames_corrected = int(rotated.any(axis=1).sum())
-    res = c.residual_m[rotated] if rotated.any() else np.zeros(1)
+    into = np.isin(c.status, (K.ROTATED, K.CONSTRAINED))
+    res = c.residual_m[into] if into.any() else np.zeros(1)
+    short = np.isin(c.status, (K.CLOSEST, K.LIMITED, K.UNREACHABLE))
+    res_short = c.residual_m[short] if short.any() else np.zeros(1)
     assert poses.raw_positions is not None
     jr = _max_jumps(poses.raw_positions, valid)
     jc = _max_jumps(poses.positions, valid)
@@ -364,6 +461,12 @@ def correction_measures(correction: Correction) -> dict[str, Any]:
             for i, name in enumerate(PAIRS)
         },
         "residual_mm": {"max": round(float(res.max()) * 1e3, 6), "mean": round(float(res.mean()) * 1e3, 6)},
+        "short_of_region": {
+            "frames": int(short.any(axis=1).sum()),
+            "max_mm": round(float(res_short.max()) * 1e3, 3),
+            "mean_mm": round(float(res_short.mean()) * 1e3, 3),
+        },
+        "exceeds_own_limit": exceedance(poses),
         "max_jump_m": {
             j: {"raw": round(float(jr[INDEX[j]]), 6), "corrected": round(float(jc[INDEX[j]]), 6)} for j in legs
         },

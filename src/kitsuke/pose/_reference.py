@@ -1,6 +1,8 @@
 """Plain-numpy reference of the posture correction (SPEC §5.3), written independently of `_kernels.py` for the
 tests: vectorised angle sampling, scipy rotations, closest ellipse point by dense sampling refined with a bounded
-scalar minimisation. Slow (milliseconds per frame); not used by the library."""
+scalar minimisation. Slow (milliseconds per frame); not used by the library. It is the SPEC's rotation with the
+kernel's choice of target (the leg rotated in the previous frame stays the target) but without the plausibility
+rules: compare with `correct_poses(..., max_jump_m=inf, side_margin_m=inf)`."""
 
 from __future__ import annotations
 
@@ -64,6 +66,8 @@ def correct_reference(
             jl, jr = PAIR_JOINTS[pi]
             pel = q[INDEX["pelvis"], ::2]
             side = 0 if np.sum((q[jl, ::2] - pel) ** 2) >= np.sum((q[jr, ::2] - pel) ** 2) else 1
+            if f > 0 and valid[f - 1] and targets[f - 1, pi] >= 0:  # the leg rotated last frame stays the target
+                side = 0 if targets[f - 1, pi] == jl else 1
             prev = out[f - 1] if f > 0 and valid[f - 1] else q
             ell = regions_of(prev[None], constraints, name)[0][0]
             ins = inside_values(q[PAIR_JOINTS[pi], ::2], np.broadcast_to(ell, (2, 6)))
