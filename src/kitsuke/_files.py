@@ -36,6 +36,8 @@ def check_output(path: str | os.PathLike[str], inputs: Sequence[str | os.PathLik
             raise InputError("refusing to overwrite an input file; choose another output", out)
     if out.exists() and out.is_dir():
         raise InputError("output is a folder, expected a file name", out)
+    if not out.parent.is_dir():
+        raise InputError(f"the output's folder {str(out.parent)!r} does not exist (create it first)", out)
     return out
 
 

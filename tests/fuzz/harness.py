@@ -11,6 +11,7 @@ Used by tests/fuzz (a few examples per target, in CI) and benchmarks/fuzz_inputs
 
 from __future__ import annotations
 
+import copy
 import json
 import math
 import multiprocessing as mp
@@ -308,6 +309,7 @@ def mutate_json(seed: bytes, ops: list[tuple[str, int, object]]) -> bytes:
     Numbers like NaN and 10^400 go out as JSON spells them (NaN, Infinity, a 400-digit integer)."""
     doc = json.loads(seed)
     for action, which, value in ops:
+        value = copy.deepcopy(value)  # never mutate the shared NASTY_VALUES (a list would come to hold itself)
         nodes = list(_paths(doc))
         path, node = nodes[which % len(nodes)]
         if not path:

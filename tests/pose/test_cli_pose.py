@@ -49,6 +49,55 @@ def test_correct_with_plot_video_and_summary(extracted, tmp_path, run_cli):
     frames = list(reader)
     assert meta["codec"] == "h264" and meta["size"] == (720, 1280) and len(frames) == c.n_frames
     assert meta["fps"] == pytest.approx(20)
+    # the camera fitted to the detections, reported in source pixels (1080x1920 here)
+    fit = summary["overlay"]["fit_residual_px"]
+    assert 0 < fit["mean"] <= fit["p95"] <= fit["worst"] and fit["mean"] < 40
+
+
+def test_overlay_draws_the_detected_landmarks(extracted):
+    """The raw skeleton is the 2D detection itself, and joints the correction left alone stay on it."""
+    from kitsuke.pose import correct_poses
+    from kitsuke.pose._output import image_skeletons
+
+    c = correct_poses(read_poses(extracted))
+    f = int(np.flatnonzero(c.rotated.any(axis=1))[0])
+    raw, corrected, residual = image_skeletons(c.poses, f, 0.5)
+    assert np.array_equal(raw, c.poses.image[f, :, :2] * 0.5)
+    moved = np.linalg.norm(c.poses.positions[f] - c.poses.raw_positions[f], axis=1) > 0
+    assert moved.any() and np.array_equal(corrected[~moved], raw[~moved])
+    assert (np.linalg.norm(corrected[moved] - raw[moved], axis=1) > 1).any()
+    assert np.nanmax(residual) < 200
+
+
+def test_side_by_side_video(extracted, tmp_path, run_cli):
+    out, mp4 = tmp_path / "c.json", tmp_path / "sbs.mp4"
+    r = run_cli("pose", "correct", extracted, "-o", out, "--video", mp4, "--side-by-side")
+    assert r.code == 0, r.err
+    import imageio_ffmpeg
+
+    reader = imageio_ffmpeg.read_frames(str(mp4))
+    meta = next(reader)
+    frames = [np.frombuffer(b, np.uint8).reshape(1280, 1440, 3) for b in reader]
+    assert meta["codec"] == "h264" and meta["size"] == (1440, 1280) and len(frames) == read_poses(out).n_frames
+    # two different panels: the right one has the corrected skeleton and the legend
+    assert np.abs(frames[0][:, :720].astype(int) - frames[0][:, 720:].astype(int)).mean() > 0.5
+
+
+def test_missing_output_folder_is_refused(tmp_path, extracted, run_cli):
+    target = tmp_path / "nope" / "poses.json"
+    for args in (["pose", "correct", extracted, "-o", target], ["pose", "extract", extracted, "-o", target]):
+        r = run_cli(*args)
+        assert r.code == 2 and "does not exist" in r.err and r.err.count("\n") == 1, r.err
+    r = run_cli("pose", "correct", extracted, "-o", tmp_path / "c.json", "--video", tmp_path / "nope" / "v.mp4")
+    assert r.code == 2 and "does not exist" in r.err
+    assert not (tmp_path / "nope").exists()
+
+
+def test_no_person_is_a_warning(tmp_path, run_cli):
+    blank = tmp_path / "empty_room.png"
+    Image.fromarray(np.full((240, 320, 3), 90, np.uint8)).save(blank)
+    r = run_cli("pose", "extract", blank, "-o", tmp_path / "p.json")
+    assert r.code == 0 and "warning: no person found in the image" in r.err
 
 
 def test_correct_bvh_draws_synthetic_views(tmp_path, run_cli):

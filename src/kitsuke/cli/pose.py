@@ -100,6 +100,11 @@ def register(parser: argparse.ArgumentParser) -> None:
         metavar="MP4",
         help="write an H.264 overlay video: raw skeleton grey, corrected in colour (rotated parts red)",
     )
+    p.add_argument(
+        "--side-by-side",
+        action="store_true",
+        help="with --video: the raw skeleton on the left copy of each frame, the corrected one on the right",
+    )
     p.add_argument("--summary", metavar="JSON", help="also write the summary to this file")
     p.set_defaults(run=run_correct)
 
@@ -144,6 +149,12 @@ def _inputs(args: argparse.Namespace) -> list[str]:
     return [a for a in (args.source, getattr(args, "constraints", None)) if a]
 
 
+def _warn_if_nobody(poses) -> None:  # noqa: ANN001 - PoseSequence, imported lazily
+    if poses.n_frames and not poses.valid.any():
+        what = "the image" if poses.n_frames == 1 else f"any of the {poses.n_frames} frames"
+        print(f"warning: no person found in {what}", file=sys.stderr)
+
+
 def run_extract(args: argparse.Namespace) -> int:
     from .._files import check_output
     from ..pose import write_poses
@@ -153,6 +164,7 @@ def run_extract(args: argparse.Namespace) -> int:
     write_poses(poses, out)
     n_valid = int(poses.valid.sum())
     print(f"wrote {out}: {poses.n_frames} frames ({n_valid} with a person) at {poses.fps:g} fps", file=sys.stderr)
+    _warn_if_nobody(poses)
     if poses.source.get("truncated"):
         print(
             f"warning: the video ended after {poses.source['frames_decoded']} of {poses.source['frames']} frames "
@@ -192,9 +204,10 @@ def run_correct(args: argparse.Namespace) -> int:
     base = Path(args.source).parent if args.source else None
     if args.plot:
         plot_distances(correction, args.plot, title=str(args.source if args.source else f"camera {args.camera}"))
-    if args.video:
-        write_overlay_video(correction, args.video, base_dir=base)
     summary = {"output": str(out), **measures}
+    if args.video:
+        summary["overlay"] = write_overlay_video(correction, args.video, base_dir=base, side_by_side=args.side_by_side)
+    _warn_if_nobody(poses)
     if args.summary:
         write_json_atomic(args.summary, summary)
     print(json.dumps(summary, indent=1))

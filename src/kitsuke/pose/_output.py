@@ -1,11 +1,13 @@
 """What `kitsuke pose correct` shows: a plot of the leg distances against the kimono's limit, and an overlay video
-(raw skeleton in grey, corrected one in colour) as H.264 mp4.
+(raw skeleton in grey, corrected one in colour, with a legend; or raw | corrected side by side) as H.264 mp4.
 
-Registration of the 3D skeleton with a video frame: per frame, an affine camera (2×4 matrix M, so
-[u, v] = M·[X, Y, Z, 1]) is fitted by least squares from that frame's (pre-correction) 3D joints to their detected
-image points, each joint weighted by its visibility. MediaPipe's world coordinates are metric and hip-centred, its
-image points perspective; over a person's depth the affine (weak-perspective) model is within a few pixels, and
-since the raw and the corrected skeletons go through the same M, they coincide wherever nothing was corrected.
+On video frames the raw skeleton is what was detected: MediaPipe's 2D landmarks, drawn as they are. The corrected
+one is the same points plus each joint's 3D correction projected into the image: per frame an affine camera (2×4
+matrix M, [u, v] = M·[X, Y, Z, 1]) is fitted by least squares from the raw 3D joints to their detected points,
+weighted by visibility, and the correction offsets go through its linear part. Joints the correction did not move
+stay exactly on their detections, so a poor fit (MediaPipe's world coordinates are hip-centred and metric, its
+image points perspective) can only misplace the corrected offsets, not the skeleton; the fit's residual is
+measured and reported.
 """
 
 from __future__ import annotations
@@ -227,6 +229,49 @@ def _synthetic_frame(
     return img
 
 
+def _legend(cv2: Any, img: np.ndarray, lines: list[tuple[str, tuple[int, int, int]]], origin=(10, 10)) -> None:
+    """A small legend box: one coloured line sample and its label per entry."""
+    x0, y0 = origin
+    h = 22 * len(lines) + 8
+    w = 12 + 30 + 8 + max(cv2.getTextSize(t, cv2.FONT_HERSHEY_SIMPLEX, 0.5, 1)[0][0] for t, _ in lines) + 10
+    box = img[y0 : y0 + h, x0 : x0 + w]
+    box[:] = (0.45 * box).astype(np.uint8)  # darken behind the text, keep the frame visible
+    for i, (text, col) in enumerate(lines):
+        y = y0 + 18 + 22 * i
+        cv2.line(img, (x0 + 12, y - 5), (x0 + 42, y - 5), col, 4, cv2.LINE_AA)
+        cv2.putText(img, text, (x0 + 50, y), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1, cv2.LINE_AA)
+
+
+LEGEND = [
+    ("raw pose", GREY["l"]),
+    ("corrected: left", COLOUR["l"]),
+    ("corrected: right", COLOUR["r"]),
+    ("rotated by the correction", COLOUR["hot"]),
+]
+LEGEND_SIDE = [("left", COLOUR["l"]), ("right", COLOUR["r"]), ("rotated by the correction", COLOUR["hot"])]
+
+
+def image_skeletons(poses: Any, f: int, scale: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Frame f's skeletons in the image: (raw (J, 2) px: the detected landmarks, corrected (J, 2) px, the affine
+    camera's residual (J,) px on the joints seen with visibility ≥ 0.5, NaN elsewhere), at `scale` times the
+    source's pixels; None without a detection.
+
+    The corrected skeleton starts from what was seen: each joint's detected point plus its 3D correction
+    (corrected − raw, metres) projected by the linear part of an affine camera fitted to that frame's detected
+    points; joints the correction did not move stay exactly on their detections.
+    """
+    if not poses.valid[f] or poses.image is None or not np.isfinite(poses.image[f, :, :2]).all():
+        return None
+    uv = poses.image[f, :, :2] * scale
+    vis = poses.image[f, :, 2]
+    raw3d = poses.raw_positions[f]
+    m = fit_affine_camera(raw3d, uv, vis)
+    corrected = uv + (poses.positions[f] - raw3d) @ m[:, :3].T
+    residual = np.linalg.norm(_project(m, raw3d) - uv, axis=1) / scale
+    residual[vis < 0.5] = np.nan
+    return uv, corrected, residual
+
+
 def write_overlay_video(
     correction: Correction,
     path: str | os.PathLike[str],
@@ -234,12 +279,16 @@ def write_overlay_video(
     base_dir: str | os.PathLike[str] | None = None,
     max_side: int = 1280,
     synthetic_size: tuple[int, int] = (960, 540),
-) -> Path:
-    """H.264 mp4 of the raw skeleton (grey) and the corrected one (colour; rotated segments red).
+    side_by_side: bool = False,
+) -> dict[str, Any]:
+    """H.264 mp4 of the raw skeleton (grey) and the corrected one (colour: left blue, right orange, rotated
+    segments red), with a legend. Returns what it measured: the affine camera's residual, px.
 
-    Video and image sources: drawn on their frames (registered by `fit_affine_camera`), scaled so the longer side
-    is at most `max_side` px. Other sources (BVH, JSON without frames): a front view and a top view with the
-    kimono regions K of the corrected pose, on a dark background of `synthetic_size`.
+    Video and image sources: drawn on their frames (`image_skeletons`: the raw skeleton is the detected 2D
+    landmarks, the corrected one those plus the projected 3D correction), scaled so the longer side is at most
+    `max_side` px; `side_by_side` puts the raw skeleton on the left copy of the frame and the corrected one on the
+    right. Other sources (BVH, JSON without frames): a front view and a top view with the kimono regions K of the
+    corrected pose, on a dark background of `synthetic_size`.
     """
     import imageio_ffmpeg
 
@@ -258,12 +307,14 @@ def write_overlay_video(
         it, s = None, 1.0
         size = (synthetic_size[0] // 2 * 2, synthetic_size[1] // 2 * 2)
         scale, pelvis = _views(poses, *size)
+    out_size = (2 * size[0], size[1]) if side_by_side and it is not None else size
     fps = float(poses.fps)
     params = ["-preset", "veryfast", "-crf", "23", "-movflags", "+faststart", "-f", "mp4"]
+    residuals: list[np.ndarray] = []
     with atomic_path(path) as tmp:
         writer = imageio_ffmpeg.write_frames(
             str(tmp),
-            size,
+            out_size,
             fps=fps,
             codec="libx264",
             quality=None,
@@ -281,26 +332,49 @@ def write_overlay_video(
                         highlight |= {tj} | {j for j in range(len(JOINTS)) if _below(j, tj)}
                 if it is None:
                     img = _synthetic_frame(cv2, poses, f, size, scale, pelvis, correction, highlight)
+                    _legend(cv2, img, LEGEND, (10, 34))
                 else:
                     frame = next(it, None)
                     img = np.zeros((size[1], size[0], 3), np.uint8) if frame is None else cv2.resize(frame, size)
-                    if poses.valid[f] and np.isfinite(poses.image[f]).all():
-                        vis = poses.image[f, :, 2]
-                        m = fit_affine_camera(poses.raw_positions[f], poses.image[f, :, :2] * s, vis)
-                        _draw_skeleton(cv2, img, _project(m, poses.raw_positions[f]), GREY, 7)
-                        _draw_skeleton(cv2, img, _project(m, poses.positions[f]), COLOUR, 3, highlight)
+                    right = img.copy() if side_by_side else img
+                    sk = image_skeletons(poses, f, s)
+                    if sk is not None:
+                        raw_uv, cor_uv, res = sk
+                        residuals.append(res[np.isfinite(res)])
+                        if side_by_side:
+                            _draw_skeleton(cv2, img, raw_uv, COLOUR, 3)
+                            _draw_skeleton(cv2, right, cor_uv, COLOUR, 3, highlight)
+                        else:
+                            _draw_skeleton(cv2, img, raw_uv, GREY, 7)
+                            _draw_skeleton(cv2, img, cor_uv, COLOUR, 3, highlight)
+                    if side_by_side:
+                        for panel, title in ((img, "raw"), (right, "corrected")):
+                            cv2.putText(panel, title, (10, 28), cv2.FONT_HERSHEY_SIMPLEX, 0.8, (255, 255, 255), 2)
+                        _legend(cv2, right, LEGEND_SIDE, (10, 40))
+                        img = np.hstack([img, right])
+                    else:
+                        _legend(cv2, img, LEGEND)
                 label = f"t={poses.times[f]:.2f}s"
                 if highlight:
                     label += "  corrected: " + ", ".join(
                         JOINTS[t] for t in correction.target[f] if t >= 0 and t in highlight
                     )
                 cv2.putText(
-                    img, label, (10, size[1] - 12), cv2.FONT_HERSHEY_SIMPLEX, 0.6, (255, 255, 255), 2, cv2.LINE_AA
+                    img, label, (10, out_size[1] - 12), cv2.FONT_HERSHEY_SIMPLEX, 0.6, (255, 255, 255), 2, cv2.LINE_AA
                 )
                 writer.send(np.ascontiguousarray(img[:, :, ::-1]))
         finally:
             writer.close()
-    return Path(path)
+    if not residuals:
+        return {"fit_residual_px": None}
+    r = np.concatenate(residuals)
+    return {
+        "fit_residual_px": {
+            "mean": round(float(r.mean()), 2),
+            "p95": round(float(np.percentile(r, 95)), 2),
+            "worst": round(float(r.max()), 2),
+        }
+    }
 
 
 def _below(j: int, ancestor: int) -> bool:
