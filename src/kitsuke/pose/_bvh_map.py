@@ -16,23 +16,42 @@ a lower-priority word only when no higher-priority one exists):
 - clavicle: collar, clavicle; else shoulder when the side also has an upper-arm word (Mixamo/CMU-BVH
   `LeftShoulder` above `LeftArm`).  elbow: forearm, lowerarm, elbow.  wrist: hand, wrist.
 - neck: the first joint whose base contains `neck`; head: base `head`.
+Character Creator / iClone names read by the same rules: `CC_Base_L_Thigh` → hip, `L_Calf` → knee, `L_Foot` →
+ankle, `L_ToeBase` → toe, `L_Clavicle`, `L_Upperarm`, `L_Forearm`, `L_Hand`, `NeckTwist01` → neck, `Head`;
+`Hip`, `Pelvis`, `Waist`, `Spine01/02` have no side and take no role (the pelvis is mid-hips, never a hip), and
+twist helpers (`L_ThighTwist01` → thigh) lie below their bone, so the bone itself is nearer the root and wins.
 Derived joints (documented where they are built): pelvis = mid-hips (as for MediaPipe); chest = the joint where the
 two arm chains meet; clavicle = the collar joint, else a fifth of the way from the neck base to the shoulder;
 spine = the joint on the root→chest path nearest the height halfway between pelvis and chest
-(else the midpoint); head = the centre of the head (midpoint of the head joint and the highest rest-pose point
-below it, carried rigidly with the head); toe = the ankle's farthest rest-pose descendant point (the toe tip),
+(else the midpoint); head = the centre of the head (midpoint of the head joint and the highest reference-pose point
+below it, carried rigidly with the head); toe = the ankle's farthest reference-pose descendant point (the toe tip),
 unless that point is not in front of the ankle (an End Site straight below it, as in the CMU-on-MakeHuman kick);
-heel = a `heel` joint if any, else a point fixed to the ankle 0.039·H below and 0.03·H behind it (H = rest height;
-stature proportions of Drillis & Contini), and a missing toe likewise 0.12·H in front (see `_foot_points`).
+heel = a `heel` joint if any, else a point fixed to the ankle 0.039·H below and 0.03·H behind it (H = standing
+height; stature proportions of Drillis & Contini), and a missing toe likewise 0.12·H in front (see `_foot_points`).
 
-Units: the rest-pose height (top of the head to the lowest foot point) picks the file unit among m, dm, cm, mm,
-inch and CMU's ASF unit (1/0.45 inch) whose height in metres is nearest 1.7 m (ratio in log scale), unless a scale
-is given. Axes: the up axis is the rest pose's ankles→head direction (Z-up files are rotated to Y up), then the
-skeleton is turned about Y so that in the rest pose its left hip is at +X (facing +Z).
+Axes and units come from the animated frames, not from the zero pose alone: some rigs (Character Creator /
+iClone) give their bones frames turned by about 180°, so that in the zero pose (all channels zero) the legs point
+up and every frame's rotations fold them back down. They are decided on up to DECISION_FRAMES frames spread over
+the whole clip, whatever `stride` and `max_frames` keep.
+- Up: the mean over frames of head − mid-ankles, rounded to the nearest axis (±X, ±Y, ±Z; Z-up files are rotated
+  to Y up); the zero pose's only when the frames give no direction.
+- Facing: the skeleton is turned about Y so that its left hip is at +X (facing +Z), by the mean over frames of
+  the hip line (left hip − right hip) rounded to the nearest quarter turn (see `_facing_turn` for why rounded).
+- Reference pose (a pose where the skeleton stands, for the choices above and the height): the zero pose, except
+  that a joint whose orientation over the clip is on average more than FOLD_DEG away from its zero-pose
+  orientation (a folded bind frame) takes the axis-aligned orientation nearest that mean (`_reference_orientations`).
+  Skeletons that stand in their zero pose (CMU, MakeHuman, DAZ, Mixamo) keep it unchanged.
+- Units: the standing height (top of the head to the lowest foot point along up, in the reference pose; the
+  median over frames of the posed skeleton's when even the reference pose does not stand) picks the file unit
+  among m, dm, cm, mm, inch and CMU's ASF unit (1/0.45 inch) whose height in metres is nearest 1.7 m (ratio in log
+  scale), unless a scale is given.
+The poses' `source` records them: `up_axis`, `up_from`, `yaw_deg`, `units`, `rest_height_m` (the standing height),
+`height_from`, `unfolded_joints` (the joints whose bind frame was found folded).
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import re
@@ -154,8 +173,18 @@ def _ancestors(parents: np.ndarray, j: int) -> list[int]:
     return out
 
 
-def map_bvh_joints(bvh: BvhFile, path: str | os.PathLike[str] = "<bvh>") -> BvhMapping:
-    """Find the joint-set roles in a BVH skeleton; InputError listing what cannot be found."""
+def map_bvh_joints(
+    bvh: BvhFile,
+    path: str | os.PathLike[str] = "<bvh>",
+    *,
+    reference: tuple[np.ndarray, np.ndarray] | None = None,
+) -> BvhMapping:
+    """Find the joint-set roles in a BVH skeleton; InputError listing what cannot be found.
+
+    The roles come from the names alone; the toe point and the spine joint are chosen from the geometry of
+    `reference`: (J, 3) joint and (E, 3) End Site positions (file units and axes) of a pose in which the skeleton
+    stands, default the zero pose (`load_bvh` passes its reference pose, see `_reference_orientations`).
+    """
     parsed = [parse_joint_name(n) for n in bvh.names]
     depth = _depth(bvh.parents)
     n_j = len(bvh.names)
@@ -222,30 +251,34 @@ def map_bvh_joints(bvh: BvhFile, path: str | os.PathLike[str] = "<bvh>") -> BvhM
 
     toe_point: dict[str, tuple[str, int]] = {}
     heel_joint: dict[str, int] = {}
-    rest_pos, _, rest_end = forward_kinematics(bvh, rest=True)
+    if reference is None:
+        rest_pos, _, rest_end = forward_kinematics(bvh, rest=True)
+        ref_pos, ref_end = rest_pos[0], rest_end[0]
+    else:
+        ref_pos, ref_end = reference
     for side in "lr":
         ankle = joint_of[f"{side}_ankle"]
         below = _descendants(bvh.parents, ankle)
-        pts = [("joint", k, rest_pos[0, k]) for k in np.flatnonzero(below)]
+        pts = [("joint", k, ref_pos[k]) for k in np.flatnonzero(below)]
         pts += [
-            ("end", e, rest_end[0, e])
+            ("end", e, ref_end[e])
             for e in range(len(bvh.end_parents))
             if bvh.end_parents[e] == ankle or below[bvh.end_parents[e]]
         ]
         if not pts:
             raise InputError(f"cannot map BVH joints: the {side} ankle has no foot below it", path)
-        kind, idx, _ = max(pts, key=lambda t: float(np.linalg.norm(t[2] - rest_pos[0, ankle])))
+        kind, idx, _ = max(pts, key=lambda t: float(np.linalg.norm(t[2] - ref_pos[ankle])))
         toe_point[side] = (kind, int(idx))
         heel = find("heel", side, below)
         heel_joint[side] = heel
 
-    # spine: the joint between root and chest nearest half the pelvis→chest height (rest pose)
+    # spine: the joint between root and chest nearest half the pelvis→chest height (reference pose)
     path_joints = _ancestors(bvh.parents, chest)[1:-1]  # strictly between chest and root
     spine = -1
     if path_joints:
-        pelvis_rest = 0.5 * (rest_pos[0, joint_of["l_hip"]] + rest_pos[0, joint_of["r_hip"]])
-        mid = 0.5 * (pelvis_rest + rest_pos[0, chest])
-        spine = min(path_joints, key=lambda k: float(np.linalg.norm(rest_pos[0, k] - mid)))
+        pelvis_ref = 0.5 * (ref_pos[joint_of["l_hip"]] + ref_pos[joint_of["r_hip"]])
+        mid = 0.5 * (pelvis_ref + ref_pos[chest])
+        spine = min(path_joints, key=lambda k: float(np.linalg.norm(ref_pos[k] - mid)))
     return BvhMapping(joint_of, chest, spine, neck, head, toe_point, heel_joint)
 
 
@@ -269,6 +302,149 @@ def _axis_name(up: np.ndarray) -> str:
     return ("+" if up[axis] > 0 else "-") + "XYZ"[axis]
 
 
+#: At most this many frames, evenly spread over the whole clip, decide the axes, the reference pose and the height
+#: (whatever `stride` and `max_frames` keep, so that a part of a clip is read in the same axes as the whole).
+DECISION_FRAMES = 512
+#: A joint whose mean orientation over the clip is farther than this from its zero-pose orientation has a folded
+#: bind frame (Character Creator legs: about 180°); motion alone keeps the joints that matter nearer (a seated
+#: thigh is about 90° from standing).
+FOLD_DEG = 120.0
+
+
+def _cube_rotations() -> np.ndarray:
+    """(24, 3, 3): the rotations that map the coordinate axes onto themselves (signed permutations, det +1)."""
+    out = []
+    for perm in itertools.permutations(range(3)):
+        for signs in itertools.product((1.0, -1.0), repeat=3):
+            m = np.zeros((3, 3))
+            m[np.arange(3), perm] = signs
+            if np.linalg.det(m) > 0:
+                out.append(m)
+    return np.array(out)
+
+
+_CUBE = _cube_rotations()
+
+
+def _decision_frames(n: int) -> np.ndarray:
+    """Indices of at most DECISION_FRAMES frames spread evenly over a clip of n frames."""
+    return np.unique(np.linspace(0, n - 1, min(n, DECISION_FRAMES)).round().astype(np.int64))
+
+
+def _subtree(bvh: BvhFile, j: int) -> tuple[np.ndarray, np.ndarray]:
+    """Joint j's strict descendants (J,) and the End Sites on j or below it (E,), as boolean masks."""
+    below = _descendants(bvh.parents, j)
+    ends = (bvh.end_parents == j) | below[bvh.end_parents]
+    return below, ends
+
+
+def _up_vector(
+    pos: np.ndarray, rest_pos: np.ndarray, mapping: BvhMapping, path: str | os.PathLike[str]
+) -> tuple[np.ndarray, str]:
+    """The direction in which the head stays above the feet, (3,) file axes (not normalised), and where it came from.
+
+    pos : (n, J, 3) joint positions over the decision frames; rest_pos : (J, 3) the zero pose.
+    The mean over frames of head − mid-ankles: the animated skeleton stands whatever its zero pose does (rigs whose
+    zero pose folds the legs up, as Character Creator's, read upside down from the zero pose). The zero pose only
+    when the frames cancel out (nothing to go by).
+    """
+    jo = mapping.joint_of
+
+    def head_over_ankles(p: np.ndarray) -> np.ndarray:
+        return p[..., mapping.head, :] - 0.5 * (p[..., jo["l_ankle"], :] + p[..., jo["r_ankle"], :])
+
+    v = head_over_ankles(pos)
+    up = v.mean(axis=0)
+    if np.linalg.norm(up) > 1e-9 * np.linalg.norm(v, axis=1).mean():
+        return up, "motion"
+    up = head_over_ankles(rest_pos)
+    if not np.linalg.norm(up) > 0:
+        raise InputError("the head stays at the ankles in every frame and the zero pose; cannot find the up axis", path)
+    return up, "zero pose"
+
+
+def _facing_turn(hip_y: np.ndarray) -> tuple[np.ndarray, float]:
+    """The turn about Y that puts the person's left at +X: (3, 3), and its angle in radians (a multiple of π/2).
+
+    hip_y : (n, 3) left hip − right hip over the decision frames, in Y-up axes. Their mean's heading is rounded to
+    the nearest quarter turn: mocap files are written along their axes, while a person turns during a clip (the
+    CMU kick's mean hip line is 22° off its run-up, the walk's −16° off its path), so the nearest axis recovers the
+    file's forward where the exact mean would not. The first frame decides when the mean has no heading.
+    """
+    h = hip_y.mean(axis=0)
+    if not math.hypot(h[0], h[2]) > 1e-9 * np.linalg.norm(hip_y, axis=1).mean():
+        h = hip_y[0]  # turns evenly all round: nothing better than where it starts
+    quarter = round(math.atan2(h[2], h[0]) / (math.pi / 2)) % 4
+    c, s = ((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))[quarter]
+    turn = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])  # takes (cos yaw, ., sin yaw) to +X
+    return turn, math.pi / 2 * (quarter if quarter < 3 else -1)
+
+
+def _reference_orientations(rot: np.ndarray, hip_out: np.ndarray, axes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each joint's world orientation in a pose where the skeleton stands: (J, 3, 3) file axes, and (J,) folded.
+
+    rot : (n, J, 3, 3) world rotations over the decision frames (file axes); hip_out : (n, 3) hip lines in output
+    axes (Y up, facing +Z); axes : (3, 3) rotation from file to output axes.
+    Each frame's turn about Y (its hip line's heading) is taken out first, so that a walk that turns round averages
+    like one that does not. A joint whose mean orientation over the clip lies within FOLD_DEG of the zero pose
+    keeps the zero pose (identity: skeletons that already stood in their zero pose are read exactly as before);
+    a farther one has a folded bind frame and takes the axis-aligned rotation nearest its mean. Bind frames differ
+    between rigs by such rotations, so the reference pose (and every choice made in it) is the same for a clip
+    written on either rig.
+    """
+    psi = np.arctan2(hip_out[:, 2], hip_out[:, 0])
+    c, s = np.cos(psi), np.sin(psi)
+    heading = np.zeros((len(psi), 3, 3))  # about Y, taking +X to the frame's hip direction
+    heading[:, 0, 0], heading[:, 0, 2], heading[:, 1, 1] = c, -s, 1.0
+    heading[:, 2, 0], heading[:, 2, 2] = s, c
+    untwist = np.einsum("ba,ncb,cd->nad", axes, heading, axes)  # axesᵀ·headingᵀ·axes: un-turn, in file axes
+    mean = np.einsum("nab,njbc->jac", untwist, rot) / len(rot)
+    u, _, vt = np.linalg.svd(mean)
+    u[:, :, 2] *= np.linalg.det(u @ vt)[:, None]  # the nearest proper rotation (chordal mean)
+    nearest = u @ vt
+    cos = np.clip((np.trace(nearest, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    folded = np.degrees(np.arccos(cos)) > FOLD_DEG
+    snapped = _CUBE[np.argmax(np.einsum("kab,jab->jk", _CUBE, nearest), axis=1)]
+    return np.where(folded[:, None, None], snapped, np.eye(3)), folded
+
+
+def _pose_with_orientations(bvh: BvhFile, orient: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Joint (J, 3) and End Site (E, 3) positions, file units, of the skeleton with the given world orientations
+    (J, 3, 3), root at the origin (the zero pose for identities)."""
+    pos = np.zeros((len(bvh.names), 3))
+    for j, par in enumerate(bvh.parents):
+        if par >= 0:
+            pos[j] = pos[par] + orient[par] @ bvh.offsets[j]
+    end = pos[bvh.end_parents] + np.einsum("eij,ej->ei", orient[bvh.end_parents], bvh.end_offsets)
+    return pos, end
+
+
+def _height(bvh: BvhFile, mapping: BvhMapping, up: np.ndarray, pos: np.ndarray, end: np.ndarray) -> np.ndarray:
+    """Top of the head to the lowest foot point along `up` (3,), file units: (n,) for (n, J, 3)/(n, E, 3) poses."""
+    head_j, head_e = _subtree(bvh, mapping.head)
+    head_j[mapping.head] = True
+    foot_j = np.zeros(len(bvh.names), dtype=bool)
+    foot_e = np.zeros(len(bvh.end_parents), dtype=bool)
+    for side in "lr":
+        ankle = mapping.joint_of[f"{side}_ankle"]
+        below, ends = _subtree(bvh, ankle)
+        foot_j |= below
+        foot_j[ankle] = True
+        foot_e |= ends
+    h_pos, h_end = pos @ up, end @ up
+    top = np.maximum(h_pos[:, head_j].max(axis=1), h_end[:, head_e].max(axis=1, initial=-np.inf))
+    bottom = np.minimum(h_pos[:, foot_j].min(axis=1), h_end[:, foot_e].min(axis=1, initial=np.inf))
+    return top - bottom
+
+
+def _stands(mapping: BvhMapping, up: np.ndarray, pos: np.ndarray) -> bool:
+    """Whether a pose (J, 3) has, along `up`, the head above the hips and the hips above both ankles."""
+    jo = mapping.joint_of
+    h = pos @ up
+    hips = 0.5 * (h[jo["l_hip"]] + h[jo["r_hip"]])
+    return bool(h[mapping.head] > hips > max(h[jo["l_ankle"]], h[jo["r_ankle"]]))
+
+
 def load_bvh(
     path: str | os.PathLike[str],
     *,
@@ -276,37 +452,57 @@ def load_bvh(
     stride: int = 1,
     max_frames: int | None = None,
 ) -> PoseSequence:
-    """Read a BVH file as a `PoseSequence` in metres, Y up, facing +Z (rest pose), by the rules of this module.
+    """Read a BVH file as a `PoseSequence` in metres, Y up, facing +Z, by the rules of this module.
 
     Parameters
     ----------
-    scale : metres per file unit; default: picked from the rest-pose height (module docstring).
+    scale : metres per file unit; default: picked from the standing height (module docstring).
     stride : keep every `stride`-th frame.  max_frames : keep at most this many frames.
 
+    The axes, the height and the reference pose are decided on the whole clip, whatever frames are kept.
     InputError for unreadable files, and for skeletons whose names cannot be mapped (listing what is missing).
     """
     if stride < 1:
         raise InputError(f"stride must be at least 1, got {stride}", path)
     bvh = read_bvh(path)
-    mapping = map_bvh_joints(bvh, path)
+    roles = map_bvh_joints(bvh, path)  # the names' roles; toe and spine are chosen again in the reference pose
     frames = np.arange(0, bvh.n_frames, stride)
     if max_frames is not None:
         frames = frames[: max(0, int(max_frames))]
     if len(frames) == 0:
         raise InputError("no frames selected", path)
-    rest_pos, rest_rot, rest_end = forward_kinematics(bvh, rest=True)
-    pos, rot, end = forward_kinematics(bvh, frames)
 
-    jo = mapping.joint_of
-    ankles_rest = 0.5 * (rest_pos[0, jo["l_ankle"]] + rest_pos[0, jo["r_ankle"]])
-    up_vec = rest_pos[0, mapping.head] - ankles_rest
-    if not np.linalg.norm(up_vec) > 0:
-        raise InputError("rest pose has the head at the ankles; cannot find the up axis", path)
+    # axes: up, then facing, from the animated skeleton (module docstring)
+    rest_pos, _, _ = forward_kinematics(bvh, rest=True)
+    decision = _decision_frames(bvh.n_frames)
+    d_pos, d_rot, d_end = forward_kinematics(bvh, decision)
+    with np.errstate(all="ignore"):
+        # Finite numbers can still overflow through the offsets and rotations (1e308-sized values), and sums of
+        # positions near that size overflow in the decisions below: such files are no skeleton.
+        bad = ~((np.abs(d_pos) < 1e300).all(axis=(1, 2)) & (np.abs(d_end) < 1e300).all(axis=(1, 2)))
+    if bad.any():
+        raise InputError(f"frame {int(decision[np.argmax(bad)])}: joint positions overflow (values too large)", path)
+    up_vec, up_from = _up_vector(d_pos, rest_pos[0], roles, path)
     to_y = _rotation_to_y_up(up_vec)
-    all_rest = np.concatenate([rest_pos[0], rest_end[0]]) @ to_y.T
-    height_units = float(all_rest[:, 1].max() - all_rest[:, 1].min())
+    jo = roles.joint_of
+    hip_y = (d_pos[:, jo["l_hip"]] - d_pos[:, jo["r_hip"]]) @ to_y.T
+    turn, yaw = _facing_turn(hip_y)
+    axes = turn @ to_y  # file axes -> Y up, facing +Z (a signed permutation)
+
+    # the reference pose: the zero pose with folded bind frames turned as the clip holds them
+    orient, folded = _reference_orientations(d_rot, hip_y @ turn.T, axes)
+    ref_pos, ref_end = _pose_with_orientations(bvh, orient)
+    mapping = map_bvh_joints(bvh, path, reference=(ref_pos, ref_end))
+    up_file = to_y[1]  # the file-axes direction that becomes +Y
+    if _stands(mapping, up_file, ref_pos):
+        height_units = float(_height(bvh, mapping, up_file, ref_pos[None], ref_end[None])[0])
+        height_from = "reference pose"
+    else:
+        # a bind frame too far from any axis to be unfolded: the posed skeleton is all there is
+        height_units = float(np.median(_height(bvh, mapping, up_file, d_pos, d_end)))
+        height_from = "posed frames (median)"
     if not height_units > 0:
-        raise InputError("rest pose has no height", path)
+        raise InputError("the skeleton has no height", path)
     if scale is None:
         unit = min(UNITS, key=lambda u: abs(math.log(height_units * UNITS[u] / 1.7)))
         s = UNITS[unit]
@@ -314,17 +510,17 @@ def load_bvh(
         if not (scale > 0 and math.isfinite(scale)):
             raise InputError(f"scale must be a positive number of metres per unit, got {scale}", path)
         unit, s = "given", float(scale)
-    # turn about Y so the rest pose's left hip is at +X (the person faces +Z)
-    hip_axis = (rest_pos[0, jo["l_hip"]] - rest_pos[0, jo["r_hip"]]) @ to_y.T
-    yaw = math.atan2(hip_axis[2], hip_axis[0])  # rotate by +yaw about Y takes (cos, ., sin) to +X
-    c, sn = math.cos(yaw), math.sin(yaw)
-    turn = np.array([[c, 0.0, sn], [0.0, 1.0, 0.0], [-sn, 0.0, c]])
-    conv = s * (turn @ to_y)  # file units/axes -> metres, Y up, facing +Z
+    conv = s * axes  # file units/axes -> metres, Y up, facing +Z
 
+    pos, rot, end = forward_kinematics(bvh, frames)
     out = np.empty((len(frames), len(JOINTS), 3))
 
     def put(name: str, xyz_file: np.ndarray) -> None:
         out[:, INDEX[name]] = xyz_file @ conv.T
+
+    def carried(j: int, local: np.ndarray) -> np.ndarray:
+        """(n, 3) file-axes positions of a point fixed to joint j's frame at `local` (3,) from it."""
+        return pos[:, j] + np.einsum("nij,j->ni", rot[:, j], local)
 
     for name, j in jo.items():
         put(name, pos[:, j])
@@ -334,41 +530,29 @@ def load_bvh(
         put("spine", pos[:, mapping.spine])
     else:
         put("spine", 0.5 * (0.5 * (pos[:, jo["l_hip"]] + pos[:, jo["r_hip"]]) + pos[:, mapping.chest]))
-    # head centre: midpoint of the head joint and the highest rest point below it, fixed to the head's frame
-    h = mapping.head
-    below = _descendants(bvh.parents, h)
-    cand = [rest_pos[0, k] for k in np.flatnonzero(below)]
-    cand += [
-        rest_end[0, e] for e in range(len(bvh.end_parents)) if bvh.end_parents[e] == h or below[bvh.end_parents[e]]
-    ]
-    if cand:
-        top = max(cand, key=lambda p: float((p @ to_y.T)[1]))
-        head_local = 0.5 * (top - rest_pos[0, h])  # rest rotations are identity: world offset = local offset
-    else:
-        head_local = np.zeros(3)
-    put("head", pos[:, h] + np.einsum("nij,j->ni", rot[:, h], head_local))
+    put("head", carried(mapping.head, _head_centre_local(bvh, mapping, ref_pos, ref_end, orient, up_file)))
     if mapping.neck >= 0:
         put("neck", pos[:, mapping.neck])
     else:
-        put("neck", 0.5 * (pos[:, mapping.chest] + pos[:, h]))
+        put("neck", 0.5 * (pos[:, mapping.chest] + pos[:, mapping.head]))
     derived_feet: dict[str, bool] = {}
     for side in "lr":
         if f"{side}_clavicle" not in jo:
             # no collar bone: a point a fifth of the way from the neck base towards the shoulder
             put(f"{side}_clavicle", 0.8 * out_file_neck(pos, mapping) + 0.2 * pos[:, jo[f"{side}_shoulder"]])
         ankle = jo[f"{side}_ankle"]
-        _, toe_derived, heel_local, toe_local = _foot_points(
-            bvh, mapping, side, rest_pos, rest_end, to_y, turn, height_units
+        toe_derived, heel_local, toe_local = _foot_points(
+            mapping, side, ref_pos, ref_end, orient, to_y, turn, height_units
         )
         if toe_derived:
-            put(f"{side}_toe", pos[:, ankle] + np.einsum("nij,j->ni", rot[:, ankle], toe_local))
+            put(f"{side}_toe", carried(ankle, toe_local))
         else:
             kind, idx = mapping.toe_point[side]
             put(f"{side}_toe", end[:, idx] if kind == "end" else pos[:, idx])
         if mapping.heel_joint[side] >= 0:
             put(f"{side}_heel", pos[:, mapping.heel_joint[side]])
         else:
-            put(f"{side}_heel", pos[:, ankle] + np.einsum("nij,j->ni", rot[:, ankle], heel_local))
+            put(f"{side}_heel", carried(ankle, heel_local))
         derived_feet[side] = toe_derived
 
     with np.errstate(all="ignore"):
@@ -385,8 +569,11 @@ def load_bvh(
         "units": unit,
         "metres_per_unit": s,
         "rest_height_m": round(height_units * s, 4),
+        "height_from": height_from,
         "up_axis": _axis_name(up_vec),
+        "up_from": up_from,
         "yaw_deg": round(math.degrees(yaw), 3),
+        "unfolded_joints": [bvh.names[k] for k in np.flatnonzero(folded)],
         "joint_map": mapping.describe(bvh),
     }
     for side in "lr":
@@ -401,6 +588,25 @@ def load_bvh(
     )
 
 
+def _head_centre_local(
+    bvh: BvhFile,
+    mapping: BvhMapping,
+    ref_pos: np.ndarray,
+    ref_end: np.ndarray,
+    orient: np.ndarray,
+    up: np.ndarray,
+) -> np.ndarray:
+    """(3,) the head centre in the head joint's frame, file units: half way from the head joint to the highest
+    point below it in the reference pose (`up` (3,) in file axes), zero when nothing is below the head."""
+    h = mapping.head
+    below, ends = _subtree(bvh, h)
+    cand = np.concatenate([ref_pos[below], ref_end[ends]])
+    if not len(cand):
+        return np.zeros(3)
+    top = cand[int(np.argmax(cand @ up))]
+    return 0.5 * orient[h].T @ (top - ref_pos[h])  # reference world offset -> the head's own frame
+
+
 #: Anthropometric proportions of stature (Drillis & Contini): ankle height above the sole, heel behind the ankle,
 #: toe tip in front of the ankle (foot length 0.152 minus the heel part).
 ANKLE_HEIGHT = 0.039
@@ -409,39 +615,38 @@ TOE_FRONT = 0.12
 
 
 def _foot_points(
-    bvh: BvhFile,
     mapping: BvhMapping,
     side: str,
-    rest_pos: np.ndarray,
-    rest_end: np.ndarray,
+    ref_pos: np.ndarray,
+    ref_end: np.ndarray,
+    orient: np.ndarray,
     to_y: np.ndarray,
     turn: np.ndarray,
     height_units: float,
-) -> tuple[np.ndarray, bool, np.ndarray, np.ndarray]:
+) -> tuple[bool, np.ndarray, np.ndarray]:
     """Heel (and, for skeletons without a forward toe, toe) as points fixed to the ankle joint's frame.
 
-    In the rest pose (all rotations identity, so world offsets are the ankle's local offsets) the heel lies
-    ANKLE_HEIGHT·H below the ankle and HEEL_BACK·H behind it, "behind" being against the horizontal ankle→toe
-    direction (H = rest height). When the farthest point below the ankle is not in front of it (less than 2 % of
-    H horizontally, e.g. an End Site straight under the ankle) the toe is derived the same way, TOE_FRONT·H in
-    front of the ankle along the facing direction (+Z after conversion), at the sole.
-    Returns (toe point in file units at rest, toe derived?, heel local offset, toe local offset) in file axes.
+    In the reference pose (ref_pos (J, 3), ref_end (E, 3), world orientations orient (J, 3, 3), file units and
+    axes) the heel lies ANKLE_HEIGHT·H below the ankle and HEEL_BACK·H behind it, "behind" being against the
+    horizontal ankle→toe direction (H = standing height, file units). When the farthest point below the ankle is not
+    in front of it (less than 2 % of H horizontally, e.g. an End Site straight under the ankle) the toe is derived
+    the same way, TOE_FRONT·H in front of the ankle along the facing direction (+Z after conversion), at the sole.
+    Returns (toe derived?, heel offset (3,), toe offset (3,)), in the ankle's own frame, file units.
     """
     ankle = mapping.joint_of[f"{side}_ankle"]
     kind, idx = mapping.toe_point[side]
-    toe_rest = rest_end[0, idx] if kind == "end" else rest_pos[0, idx]
-    a_y = rest_pos[0, ankle] @ to_y.T
-    t_y = toe_rest @ to_y.T
-    fwd = t_y - a_y
+    toe_ref = ref_end[idx] if kind == "end" else ref_pos[idx]
+    fwd = (toe_ref - ref_pos[ankle]) @ to_y.T
     fwd[1] = 0.0
     derived = float(np.linalg.norm(fwd)) < 0.02 * height_units
     if derived:
         fwd = turn.T @ np.array([0.0, 0.0, 1.0])  # facing direction (+Z after the turn), in Y-up axes
     fwd = fwd / np.linalg.norm(fwd)
     down = np.array([0.0, -ANKLE_HEIGHT * height_units, 0.0])
-    heel_local = (down - HEEL_BACK * height_units * fwd) @ to_y  # Y-up axes back to file axes
-    toe_local = (down + TOE_FRONT * height_units * fwd) @ to_y
-    return toe_rest, derived, heel_local, toe_local
+    to_local = orient[ankle].T  # reference world offset -> the ankle's own frame
+    heel_local = to_local @ ((down - HEEL_BACK * height_units * fwd) @ to_y)  # Y-up axes back to file axes
+    toe_local = to_local @ ((down + TOE_FRONT * height_units * fwd) @ to_y)
+    return derived, heel_local, toe_local
 
 
 def out_file_neck(pos: np.ndarray, mapping: BvhMapping) -> np.ndarray:
