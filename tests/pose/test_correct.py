@@ -261,7 +261,8 @@ def test_real_sequences_keep_sides_and_mostly_do_not_jump(which, balancing_raw, 
     inv = check_invariants(c)
     assert inv["sides_swapped"] == 0, inv
     if which == "balancing":
-        assert inv["jumps_over_limit"] == 0, inv
+        # measured 0 here; MediaPipe's numbers move slightly between CPUs, so allow a stray transition
+        assert inv["jumps_over_limit"] <= 2 and inv["worst_jump_excess_m"] < 0.05, inv
     else:
         # Mocap at full kicks and strides: where no rotation of the thigh or shin keeps every joint of the chain
         # within 5 cm of its last place, the one that jumps least is taken (measured 2026-11-26: kick 4 of 200
