@@ -20,6 +20,7 @@ import numpy as np
 
 from .. import limits
 from .._files import require_file
+from .._prefetch import prefetch
 from .._progress import progress
 from ..errors import InputError
 from ..skeleton import JOINTS
@@ -275,7 +276,10 @@ def extract_video(
     wanted = max(0, declared - first + stride - 1) // stride if declared > 0 else None
     if wanted is not None and max_frames is not None:
         wanted = min(wanted, max_frames)
-    times, valid, pos, img, _ = _collect(frames(), total=wanted, mode="video", desc="pose", **landmarker_options)
+    # decoding runs a few frames ahead in a thread (OpenCV releases the GIL): it overlaps the inference
+    times, valid, pos, img, _ = _collect(
+        prefetch(frames()), total=wanted, mode="video", desc="pose", **landmarker_options
+    )
     if len(times) == 0:
         raise InputError("the video has no decodable frames (empty or corrupt)", path)
     source: dict[str, Any] = {

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from .._files import atomic_path
+from .._prefetch import prefetch
 from .._progress import progress
 from ..errors import InputError
 from ..skeleton import BONES, INDEX, JOINTS
@@ -300,9 +301,11 @@ def write_overlay_video(
         raise ValueError("write_overlay_video needs a corrected sequence")
     frames = _source_frames(poses, Path(base_dir) if base_dir else None)
     if frames is not None:
-        it, (w0, h0) = frames
+        source_it, (w0, h0) = frames
         s = min(1.0, max_side / max(w0, h0))
         size = (int(round(w0 * s / 2)) * 2, int(round(h0 * s / 2)) * 2)
+        # decoded and scaled ahead in a thread, while this one draws and ffmpeg encodes in its own process
+        it = prefetch(None if fr is None else cv2.resize(fr, size) for fr in source_it)
     else:
         it, s = None, 1.0
         size = (synthetic_size[0] // 2 * 2, synthetic_size[1] // 2 * 2)
@@ -335,7 +338,7 @@ def write_overlay_video(
                     _legend(cv2, img, LEGEND, (10, 34))
                 else:
                     frame = next(it, None)
-                    img = np.zeros((size[1], size[0], 3), np.uint8) if frame is None else cv2.resize(frame, size)
+                    img = np.zeros((size[1], size[0], 3), np.uint8) if frame is None else frame
                     right = img.copy() if side_by_side else img
                     sk = image_skeletons(poses, f, s)
                     if sk is not None:
