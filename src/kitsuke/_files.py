@@ -36,6 +36,13 @@ def check_output(path: str | os.PathLike[str], inputs: Sequence[str | os.PathLik
             raise InputError("refusing to overwrite an input file; choose another output", out)
     if out.exists() and out.is_dir():
         raise InputError("output is a folder, expected a file name", out)
+    return out
+
+
+def check_output_folder(path: str | os.PathLike[str]) -> Path:
+    """Refuse an output whose folder does not exist (the command line: a mistyped folder is an error, not a new
+    folder; library writers create folders as they need them)."""
+    out = Path(path)
     if not out.parent.is_dir():
         raise InputError(f"the output's folder {str(out.parent)!r} does not exist (create it first)", out)
     return out

@@ -85,6 +85,16 @@ def test_huge_circle_edge_is_refused_quickly(worker, large_arc):
         ("constraints", lambda d: d["knee"]["max_distance_m"].__setitem__(0, 10**400), "finite"),
         # a list where a curve type belongs: TypeError (unhashable) before
         ("pattern-kitsuke", lambda d: d["pieces"][0].__setitem__("curves", {"0": {"type": ["cubic"]}}), "curve"),
+        ("pattern-kitsuke", lambda d: d.__setitem__("units", ["cm"]), "units"),
+        # a circle edge of zero length: ZeroDivisionError in the size check before validation named the edge
+        (
+            "pattern-kitsuke",
+            lambda d: (
+                d["pieces"][0]["outline"].insert(1, d["pieces"][0]["outline"][0]),
+                d["pieces"][0].__setitem__("curves", {"0": {"type": "circle", "control": [[0.5, 0.3]]}}),
+            ),
+            "zero length",
+        ),
     ],
 )
 def test_json_regressions(target, mutate, expect, tmp_path):

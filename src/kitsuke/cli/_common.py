@@ -6,7 +6,7 @@ import argparse
 from collections.abc import Sequence
 from pathlib import Path
 
-from .._files import check_output
+from .._files import check_output, check_output_folder
 from ..errors import InputError
 
 
@@ -44,8 +44,8 @@ def body_from_args(args: argparse.Namespace, attr: str = "body"):
 
 
 def checked_output(path: str, inputs: Sequence[str], *, suffixes: Sequence[str] = ()) -> Path:
-    """Validate an output path: a known suffix, not an input, not a folder."""
+    """Validate an output path: a known suffix, not an input, not a folder, in a folder that exists."""
     out = Path(path)
     if suffixes and out.suffix.lower() not in suffixes:
         raise InputError(f"output must end in {', '.join(suffixes)}", out)
-    return check_output(out, [i for i in inputs if i != "default"])
+    return check_output_folder(check_output(out, [i for i in inputs if i != "default"]))

@@ -7,6 +7,8 @@ import json
 import sys
 from pathlib import Path
 
+from ._common import checked_output
+
 EXTRACT_EPILOG = """\
 SOURCE is a video file, an image, a folder of images (sorted by name), a BVH file or a kitsuke poses JSON file;
 use --camera N instead of SOURCE for a live camera (Ctrl-C stops it). Poses are written in the SPEC joint set
@@ -156,10 +158,9 @@ def _warn_if_nobody(poses) -> None:  # noqa: ANN001 - PoseSequence, imported laz
 
 
 def run_extract(args: argparse.Namespace) -> int:
-    from .._files import check_output
     from ..pose import write_poses
 
-    out = check_output(args.output, _inputs(args))
+    out = checked_output(args.output, _inputs(args))
     poses = _load(args)
     write_poses(poses, out)
     n_valid = int(poses.valid.sum())
@@ -175,7 +176,7 @@ def run_extract(args: argparse.Namespace) -> int:
 
 
 def run_correct(args: argparse.Namespace) -> int:
-    from .._files import check_output, write_json_atomic
+    from .._files import write_json_atomic
     from ..errors import InputError
     from ..pose import (
         correct_poses,
@@ -187,13 +188,13 @@ def run_correct(args: argparse.Namespace) -> int:
     )
 
     inputs = _inputs(args)
-    out = check_output(args.output, inputs)
+    out = checked_output(args.output, inputs)
     outs = [out]
     for extra, suffix in ((args.plot, ".png"), (args.video, ".mp4"), (args.summary, ".json")):
         if extra:
             if Path(extra).suffix.lower() != suffix:
                 raise InputError(f"must be a {suffix} file", extra)
-            outs.append(check_output(extra, inputs))
+            outs.append(checked_output(extra, inputs))
     if len({p.resolve() for p in outs}) != len(outs):
         raise InputError("the output files must be different")
     table = read_constraints(args.constraints) if args.constraints else None

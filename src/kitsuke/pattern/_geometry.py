@@ -49,6 +49,8 @@ def abs_to_rel(p0: np.ndarray, p1: np.ndarray, pts: np.ndarray) -> np.ndarray:
 def _arc_geometry(p0: np.ndarray, p1: np.ndarray, y: float) -> tuple[np.ndarray, float, float, float]:
     """Circle arc from p0 to p1 through the relative point (0.5, y): centre, radius, start angle, signed sweep."""
     chord = float(np.linalg.norm(p1 - p0))
+    if not chord > 0.0:  # a zero-length edge (which `validate` refuses): a point
+        return np.array(p0, dtype=np.float64), 0.0, 0.0, 0.0
     h = abs(y) * chord  # sagitta: distance of the arc's middle from the chord
     radius = (h * h + 0.25 * chord * chord) / (2.0 * h)
     mid = rel_to_abs(p0, p1, np.array([[0.5, y]]))[0]
@@ -128,6 +130,8 @@ def curve_length_bound(p0: np.ndarray, p1: np.ndarray, kind: str | None, control
     """An edge's arc length at bounded cost, whatever its numbers (for the size limits, before any sampling):
     exact for lines and arcs; for a Bézier its control polygon's length when that is short (an upper bound), else
     a 1,000-segment polyline's (within a fraction of a percent of it)."""
+    if not float(np.linalg.norm(p1 - p0)) > 0.0:
+        return 0.0  # a zero-length edge: `validate` names it
     if kind in (None, "circle") or control is None:
         return curve_length(p0, p1, kind, control, MEASURE_TOL_CM)
     hull = polyline_length(np.vstack([p0, rel_to_abs(p0, p1, control), p1]))

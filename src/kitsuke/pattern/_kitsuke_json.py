@@ -148,7 +148,7 @@ def pattern_from_dict(d: Any) -> Pattern:
     if version != VERSION:
         raise InputError(f"unsupported kitsuke.pattern version {version!r} (this kitsuke reads version {VERSION})")
     units = d.get("units", "cm")
-    if units not in UNIT_TO_CM:
+    if not isinstance(units, str) or units not in UNIT_TO_CM:
         raise InputError(f"unknown units {units!r} (use cm, mm, m or in)")
     scale = UNIT_TO_CM[units]
     name = d.get("name", "pattern")
