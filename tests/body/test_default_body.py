@@ -98,11 +98,18 @@ def swing(body, joint, child, angle_rad):
     return axis / np.linalg.norm(axis) * angle_rad
 
 
+def hinge(body, root, joint, child, angle_rad):
+    """A bend of `joint` about its hinge (the normal of the rest pose's bend: the default body's elbows are bent)."""
+    j = body.rig.joints
+    axis = np.cross(j[INDEX[joint]] - j[INDEX[root]], j[INDEX[child]] - j[INDEX[joint]])
+    return axis / np.linalg.norm(axis) * angle_rad
+
+
 def test_pose_from_positions_reproduces_a_rotation_pose(body):
     rotations = {
         "l_hip": swing(body, "l_hip", "l_knee", -0.6),
         "r_shoulder": swing(body, "r_shoulder", "r_elbow", 0.5),
-        "l_elbow": swing(body, "l_elbow", "l_wrist", 0.7),
+        "l_elbow": hinge(body, "l_shoulder", "l_elbow", "l_wrist", 0.7),
     }
     target = body.pose(rotations=rotations)
     again = body.pose(positions=target.joints)
@@ -112,6 +119,23 @@ def test_pose_from_positions_reproduces_a_rotation_pose(body):
     leg = {n: target.joints[INDEX[n]] for n in ("pelvis", "l_hip", "l_knee")}
     part = body.pose(positions=leg)
     np.testing.assert_allclose(part.joints[INDEX["l_knee"]], target.joints[INDEX["l_knee"]], atol=1e-9)
+
+
+def test_a_bend_off_the_hinge_turns_the_upper_arm(body):
+    """An elbow bent sideways from positions: the shoulder twists so that the elbow bends about its own hinge (the
+    skin of the elbow does not twist), and the joints still land on their targets."""
+    target = body.pose(rotations={"l_elbow": swing(body, "l_elbow", "l_wrist", 0.9)})
+    again = body.pose(positions=target.joints)
+    np.testing.assert_allclose(again.joints, target.joints, atol=1e-9)
+    upper = again.joints[INDEX["l_elbow"]] - again.joints[INDEX["l_shoulder"]]
+    fore = again.joints[INDEX["l_wrist"]] - again.joints[INDEX["l_elbow"]]
+    rest = body.rig.joints
+    hinge_now = again.rotations[INDEX["l_shoulder"]] @ np.cross(
+        rest[INDEX["l_elbow"]] - rest[INDEX["l_shoulder"]], rest[INDEX["l_wrist"]] - rest[INDEX["l_elbow"]]
+    )
+    bend_normal = np.cross(upper, fore)
+    cos = abs(hinge_now @ bend_normal) / (np.linalg.norm(hinge_now) * np.linalg.norm(bend_normal))
+    assert cos > 0.999
 
 
 def test_rest_pose_is_identity(body):

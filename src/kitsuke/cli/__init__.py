@@ -27,7 +27,7 @@ GROUPS: dict[str, tuple[str, str]] = {
     "dress": ("dress", "put a garment on a body from a pattern and stroke pairs (wrap + settle), or re-wrap it"),
     "drag": ("drag", "drag a dressed garment along the body, with pins (replays a drags file)"),
     "render": ("render", "render meshes to PNG"),
-    "pose": ("pose", "extract poses from video/images/camera/BVH and correct them for a kimono"),
+    "pose": ("pose", "extract poses from video/images/camera/BVH, correct them for a kimono, animate the body"),
 }
 
 EPILOG = """\
@@ -42,6 +42,7 @@ examples:
   kitsuke render body.glb -o front.png --view front
   kitsuke pose extract clip.mp4 -o poses.json    # MediaPipe, bundled model; also BVH, images, --camera 0
   kitsuke pose correct clip.mp4 -o fixed.json --plot legs.png --video overlay.mp4
+  kitsuke pose animate walk.bvh -o walk.glb        # the default body, skinned and animated
 
 Run `kitsuke <group> --help` for a group's verbs and options.
 
