@@ -131,3 +131,17 @@ def test_svg_use_cycle_is_refused(tmp_path, worker):
     outcome = worker.run("pattern-svg", svg.encode())
     assert outcome.status == "input-error", outcome.detail
     assert "cycle" in outcome.detail
+
+
+@pytest.mark.parametrize(
+    ("element", "expect"),
+    [
+        # a transform that overflows the coordinates: NaN reached the curve sampler (ValueError) before
+        ('<path transform="scale(1e308) scale(1e10)" d="M 0 0 C 5 9 9 9 10 0 L 10 10 Z"/>', "not finite"),
+        ('<path d="M 0 0 L 1e12 0 L 1e12 50 Z"/>', "over the limit"),  # 10^10 m: billions of sampled points
+    ],
+)
+def test_svg_curves_checked_before_sampling(element, expect, tmp_path):
+    svg = '<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">'
+    outcome = run_case("pattern-svg", (svg + element + "</svg>").encode(), str(tmp_path))
+    assert outcome.status == "input-error" and expect in outcome.detail, outcome

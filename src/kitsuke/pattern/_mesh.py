@@ -195,7 +195,11 @@ def mesh_pattern(pattern: Pattern, *, edge_length: float = 1.5, min_angle: float
         pattern.source or "--edge-length",
     )
     if h > extent:
-        raise InputError(f"edge length {h:g} cm is longer than the largest piece ({extent:.1f} cm)", "--edge-length")
+        raise InputError(
+            f"edge length {h:g} cm is longer than the largest piece ({extent:.3g} cm across; a shorter "
+            "--edge-length meshes it)",
+            pattern.source or "--edge-length",
+        )
     counts = _segments_for(pattern, h)
     area_cap = AREA_CAP * math.sqrt(3.0) / 4.0 * h * h
     verts, faces, vpiece, pv, pf = [], [], [], [], []

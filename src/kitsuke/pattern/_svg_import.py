@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import limits
 from .._files import require_file
 from ..errors import InputError
 from . import _geometry as geo
@@ -131,7 +132,21 @@ def _split_half(edge):
     return [(p0, m, kind, np.stack([a, ab])), (m, p1, kind, np.stack([cd, d]))]
 
 
+def _check_edges(name: str, edges: list) -> None:
+    """Refuse, before any curve is sampled, numbers that are not finite (a transform can overflow them) and an edge
+    past the size limit (a curve 10^9 cm long would be sampled into billions of points). Segments of zero length
+    were dropped already (`_edges`)."""
+    for i, (p0, p1, kind, c) in enumerate(edges):
+        pts = np.vstack([p0, p1] if c is None else [p0, p1, c])
+        if not np.isfinite(pts).all():
+            raise InputError(f"shape {name!r}: segment {i} has coordinates that are not finite numbers")
+        rel = None if c is None else geo.abs_to_rel(p0, p1, c)
+        length = geo.curve_length_bound(p0, p1, kind, rel) / 100.0
+        limits.check("edge_m", length, f"shape {name!r}: segment {i} is {length:,.4g} m long")
+
+
 def _piece(name: str, edges: list) -> Piece:
+    _check_edges(name, edges)
     # A piece needs three corners: a lens or a D shape drawn with two segments gets its curves split in half.
     while len(edges) < 3:
         k = next(i for i, e in enumerate(edges) if e[2] in ("quadratic", "cubic"))
