@@ -63,6 +63,15 @@ def _circle_edge(spec: dict, radius: float, large_arc: bool) -> dict:
     return spec
 
 
+def test_zero_length_circle_edge_in_garmentcode(tmp_path):
+    spec = _shirt()
+    panel = next(iter(spec["pattern"]["panels"].values()))
+    panel["vertices"][1] = list(panel["vertices"][0])
+    panel["edges"][0]["curvature"] = {"type": "circle", "params": [10.0, False, False]}
+    outcome = run_case("pattern-garmentcode", json.dumps(spec).encode(), str(tmp_path))
+    assert outcome.status == "input-error" and "zero length" in outcome.detail, outcome
+
+
 @pytest.mark.parametrize("large_arc", [False, True])
 def test_huge_circle_edge_is_refused_quickly(worker, large_arc):
     """A GarmentCode circle edge of radius 10^9 cm hung the mesher: the large arc (6 * 10^4 km round) is refused

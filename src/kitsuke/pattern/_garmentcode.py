@@ -101,6 +101,8 @@ def _curve(raw: Any, p0: np.ndarray, p1: np.ndarray, absolute: bool, scale: floa
         chord = float(np.linalg.norm(p1 - p0))
         if not math.isfinite(radius) or radius <= 0:
             raise InputError(f"{ctx}: circle radius must be a positive number")
+        if not chord > 0.0:
+            raise InputError(f"{ctx}: a circle edge of zero length (both ends are the same vertex)")
         half = 0.5 * chord
         # A radius a hair shorter than half the chord is a rounding artefact: take the half circle.
         rest = math.sqrt(max(radius * radius - half * half, 0.0))
