@@ -11,6 +11,9 @@ Typical use::
 
 `relax` is not physics: vertices move directly towards their triangles' rest shapes, hinges open, gravity is a
 small move down, and collision pushes the cloth out of the body. Constants live in `ClothParams`.
+
+`step(model, state, body, dt)` is: XPBD dynamics on the same model and state (with velocities) against a moving
+`CapsuleBody`; constants in `DynamicsParams` (see `_dynamics.py`).
 """
 
 from ._collide import (
@@ -23,6 +26,7 @@ from ._collide import (
     track,
     vertex_active,
 )
+from ._dynamics import CapsuleBody, DynamicsData, DynamicsParams, dynamics_data, step
 from ._lengths import LengthStats, restore_lengths
 from ._model import ClothModel, ClothParams, ClothState, Contacts, locality_order
 from ._polish import PolishStats, RefinedPolish, bending_stencil, compile_polish, polish, polish_refined
@@ -35,6 +39,11 @@ from ._untangle import UntangleStats, folded_faces, grow_region, untangle
 
 __all__ = [
     "BodyCollider",
+    "CapsuleBody",
+    "DynamicsData",
+    "DynamicsParams",
+    "dynamics_data",
+    "step",
     "ClothModel",
     "ClothParams",
     "ClothState",

@@ -427,12 +427,14 @@ class ClothState:
     face_active : (F,) bool, triangles taking part (the wrap grows the garment by activating triangles). A vertex
         with no active triangle does not move.
     contacts : Contacts, the body tracking.
+    velocities : (V, 3) float64 m/s for the dynamic solver (`kitsuke.cloth.step`), None until it starts.
     """
 
     positions: np.ndarray
     pinned: np.ndarray
     face_active: np.ndarray
     contacts: Contacts
+    velocities: np.ndarray | None = None
     _work: dict = field(default_factory=dict, repr=False)
 
     @classmethod
@@ -478,7 +480,8 @@ class ClothState:
 
     def copy(self) -> ClothState:
         c = Contacts(*(getattr(self.contacts, f.name).copy() for f in fields(Contacts)))
-        return ClothState(self.positions.copy(), self.pinned.copy(), self.face_active.copy(), c)
+        v = None if self.velocities is None else self.velocities.copy()
+        return ClothState(self.positions.copy(), self.pinned.copy(), self.face_active.copy(), c, v)
 
 
 def locality_order(faces: np.ndarray, n_vertices: int | None = None) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,154 @@
+"""numba kernels of the dynamic cloth solver (XPBD, small steps). `_dynamics.py` calls them in order each substep;
+`_dynamics_reference.py` holds plain-Python versions of the same arithmetic for the tests.
+
+Every kernel works in place on (V, 3) float64 arrays. inv_mass : (V,) float64, 0 for a vertex that does not move.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def predict(x: np.ndarray, v: np.ndarray, inv_mass: np.ndarray, gravity: float, h: float, p: np.ndarray) -> None:
+    """p = x + h v after gravity (m/s², along −Y) adds to the velocity of every free vertex."""
+    for i in range(x.shape[0]):
+        if inv_mass[i] > 0.0:
+            v[i, 1] -= gravity * h
+            for c in range(3):
+                p[i, c] = x[i, c] + h * v[i, c]
+        else:
+            for c in range(3):
+                p[i, c] = x[i, c]
+
+
+@njit(cache=True)
+def solve_distances(
+    p: np.ndarray, inv_mass: np.ndarray, pairs: np.ndarray, rest: np.ndarray, alpha: float, lam: np.ndarray
+) -> None:
+    """One Gauss-Seidel sweep of XPBD distance constraints |p_a − p_b| = rest, compliance `alpha` already divided
+    by h² (0: rigid); `lam` (K,) holds each constraint's multiplier over the substep."""
+    for k in range(pairs.shape[0]):
+        a, b = pairs[k, 0], pairs[k, 1]
+        w = inv_mass[a] + inv_mass[b]
+        if w == 0.0:
+            continue
+        dx, dy, dz = p[a, 0] - p[b, 0], p[a, 1] - p[b, 1], p[a, 2] - p[b, 2]
+        d = math.sqrt(dx * dx + dy * dy + dz * dz)
+        if d < 1e-12:
+            continue
+        c = d - rest[k]
+        dl = (-c - alpha * lam[k]) / (w + alpha)
+        lam[k] += dl
+        s = dl / d
+        p[a, 0] += inv_mass[a] * s * dx
+        p[a, 1] += inv_mass[a] * s * dy
+        p[a, 2] += inv_mass[a] * s * dz
+        p[b, 0] -= inv_mass[b] * s * dx
+        p[b, 1] -= inv_mass[b] * s * dy
+        p[b, 2] -= inv_mass[b] * s * dz
+
+
+@njit(cache=True)
+def limit_strain(p: np.ndarray, inv_mass: np.ndarray, pairs: np.ndarray, rest: np.ndarray, max_strain: float) -> int:
+    """Shorten every pair longer than (1 + max_strain) rest to that length (silk barely stretches); returns how
+    many were shortened."""
+    n = 0
+    for k in range(pairs.shape[0]):
+        a, b = pairs[k, 0], pairs[k, 1]
+        w = inv_mass[a] + inv_mass[b]
+        if w == 0.0:
+            continue
+        dx, dy, dz = p[a, 0] - p[b, 0], p[a, 1] - p[b, 1], p[a, 2] - p[b, 2]
+        d = math.sqrt(dx * dx + dy * dy + dz * dz)
+        top = (1.0 + max_strain) * rest[k]
+        if d <= top:
+            continue
+        n += 1
+        s = (d - top) / (d * w)
+        p[a, 0] -= inv_mass[a] * s * dx
+        p[a, 1] -= inv_mass[a] * s * dy
+        p[a, 2] -= inv_mass[a] * s * dz
+        p[b, 0] += inv_mass[b] * s * dx
+        p[b, 1] += inv_mass[b] * s * dy
+        p[b, 2] += inv_mass[b] * s * dz
+    return n
+
+
+@njit(cache=True)
+def collide_capsules(
+    p: np.ndarray,
+    x: np.ndarray,
+    inv_mass: np.ndarray,
+    ends: np.ndarray,
+    radii: np.ndarray,
+    moved: np.ndarray,
+    offset: float,
+    friction: float,
+) -> int:
+    """Push every free vertex out of the tapered capsules (n, 2, 3) ends, (n, 2) radii, plus `offset` metres, and
+    apply Coulomb friction: the vertex's move this substep relative to the capsule's surface (`moved` (n, 2, 3):
+    how far each capsule end moved this substep) loses up to `friction` times the push along the surface.
+    Returns the number of vertices pushed."""
+    pushed = 0
+    for i in range(p.shape[0]):
+        if inv_mass[i] == 0.0:
+            continue
+        for k in range(ends.shape[0]):
+            ax, ay, az = ends[k, 0, 0], ends[k, 0, 1], ends[k, 0, 2]
+            ux, uy, uz = ends[k, 1, 0] - ax, ends[k, 1, 1] - ay, ends[k, 1, 2] - az
+            uu = ux * ux + uy * uy + uz * uz
+            t = 0.0
+            if uu > 0.0:
+                t = ((p[i, 0] - ax) * ux + (p[i, 1] - ay) * uy + (p[i, 2] - az) * uz) / uu
+                t = min(1.0, max(0.0, t))
+            cx, cy, cz = ax + t * ux, ay + t * uy, az + t * uz
+            r = radii[k, 0] + t * (radii[k, 1] - radii[k, 0]) + offset
+            nx, ny, nz = p[i, 0] - cx, p[i, 1] - cy, p[i, 2] - cz
+            d = math.sqrt(nx * nx + ny * ny + nz * nz)
+            if d >= r:
+                continue
+            if d < 1e-12:  # on the axis: out along a direction perpendicular to it
+                if ux * ux < 0.8 * uu or uu == 0.0:
+                    nx, ny, nz = 0.0, uz, -uy  # u × x
+                else:
+                    nx, ny, nz = -uz, 0.0, ux  # u × y
+                d = max(math.sqrt(nx * nx + ny * ny + nz * nz), 1e-300)
+                if uu == 0.0:
+                    nx, ny, nz, d = 1.0, 0.0, 0.0, 1.0
+            nx, ny, nz = nx / d, ny / d, nz / d
+            depth = r - d
+            p[i, 0] += depth * nx
+            p[i, 1] += depth * ny
+            p[i, 2] += depth * nz
+            # friction: the move relative to the capsule's surface, along the surface
+            sx = (1.0 - t) * moved[k, 0, 0] + t * moved[k, 1, 0]
+            sy = (1.0 - t) * moved[k, 0, 1] + t * moved[k, 1, 1]
+            sz = (1.0 - t) * moved[k, 0, 2] + t * moved[k, 1, 2]
+            rx, ry, rz = p[i, 0] - x[i, 0] - sx, p[i, 1] - x[i, 1] - sy, p[i, 2] - x[i, 2] - sz
+            rn = rx * nx + ry * ny + rz * nz
+            tx, ty, tz = rx - rn * nx, ry - rn * ny, rz - rn * nz
+            tl = math.sqrt(tx * tx + ty * ty + tz * tz)
+            if tl > 0.0:
+                cut = min(1.0, friction * depth / tl)
+                p[i, 0] -= cut * tx
+                p[i, 1] -= cut * ty
+                p[i, 2] -= cut * tz
+            pushed += 1
+    return pushed
+
+
+@njit(cache=True)
+def finish(x: np.ndarray, v: np.ndarray, p: np.ndarray, inv_mass: np.ndarray, h: float, keep: float) -> None:
+    """v = (p − x) / h times `keep` (1 − damping over the substep), x = p, for every free vertex."""
+    for i in range(x.shape[0]):
+        if inv_mass[i] == 0.0:
+            for c in range(3):
+                v[i, c] = 0.0
+            continue
+        for c in range(3):
+            v[i, c] = keep * (p[i, c] - x[i, c]) / h
+            x[i, c] = p[i, c]
