@@ -26,7 +26,7 @@ from ._collide import (
     track,
     vertex_active,
 )
-from ._dynamics import CapsuleBody, DynamicsData, DynamicsParams, dynamics_data, step
+from ._dynamics import CapsuleBody, DynamicsData, DynamicsParams, SkinHold, dynamics_data, step
 from ._lengths import LengthStats, restore_lengths
 from ._model import ClothModel, ClothParams, ClothState, Contacts, locality_order
 from ._polish import PolishStats, RefinedPolish, bending_stencil, compile_polish, polish, polish_refined
@@ -42,6 +42,7 @@ __all__ = [
     "CapsuleBody",
     "DynamicsData",
     "DynamicsParams",
+    "SkinHold",
     "dynamics_data",
     "step",
     "ClothModel",

@@ -6,11 +6,14 @@ Each step of `dt` seconds runs `DynamicsParams.substeps` substeps of h = dt / su
 2. one Gauss-Seidel sweep of stretch constraints (every mesh edge keeps its rest length, compliance
    `stretch_compliance`) and of bending constraints (the two vertices opposite each interior edge keep their flat
    rest distance, compliance `bend_compliance`): XPBD, so stiffness does not depend on h or the sweep count;
-3. the strain limit: no edge longer than (1 + `max_strain`) its rest length (silk barely stretches);
+3. the strain limit: no edge longer than (1 + `max_strain`) its rest length;
 4. collision with the moving body's capsules, pushed `contact_offset_m` outside with Coulomb friction; the
    capsules move a substep's share of their frame motion each substep (sub-stepped, so a fast leg does not pass
    through the cloth in one frame);
-5. velocities from the positions' change, damped by `damping` per second.
+5. velocities from the positions' change, damped by `damping` per second;
+6. at the last substep, with a skin (`CapsuleBody.surface`): `collide` (layer order, capsules, the skin, the
+   floor) moves the cloth out onto the skin, and only the motion into the skin is taken out of the velocities.
+Vertices held to the skin (`SkinHold`: a kimono's waist in its obi) move with it, a substep's share at a time.
 Small steps with one sweep each converge better than few steps with many sweeps (Macklin et al., "Small Steps in
 Physics Simulation", 2019), and keep the solver stable at dt = 1/30 s.
 """
@@ -23,6 +26,7 @@ import numpy as np
 
 from ..errors import ComputationError, InputError
 from . import _dynamics_kernels as K
+from ._collide import BodyCollider, collide
 from ._model import ClothModel, ClothState
 
 
@@ -33,9 +37,15 @@ class DynamicsParams:
     gravity : m/s².
     density_kg_m2 : mass of the cloth per square metre (kimono silk: 0.06-0.12 kg/m²).
     substeps : substeps per `step` (h = dt / substeps); 20 at dt = 1/30 s is h = 1.7 ms.
-    stretch_compliance : m/N of the edge constraints; 0 is inextensible (XPBD's α).
-    bend_compliance : m/N of the bending constraints; larger folds more easily (silk drapes).
-    max_strain : the strain limit: no edge longer than (1 + this) times its rest length.
+    sweeps : Gauss-Seidel sweeps of the stretch constraints per substep.
+    stretch_compliance : m/N of an edge longer than its rest length; 0 is inextensible (XPBD's α).
+    compression_compliance : m/N of an edge shorter than its rest length; larger lets cloth buckle instead of
+        pushing back.
+    bend_compliance : m/N of the bending constraints; larger folds more easily. A vertex of 2 cm silk weighs 40 mg
+        (0.4 mN): at 1 m/N a 1 mm bend pushes back with 1 mN, so silk drapes.
+    max_strain : the strain limit: no edge longer than (1 + this) times its rest length (silk barely stretches).
+        A dressed garment can start above it (the dressing's target is 5 %): `dynamics_data(..., start=)` then
+        lengthens those edges' rest lengths, so that the first step does not snap the garment shorter.
     damping : fraction of the velocity lost per second (air and internal friction).
     friction : Coulomb coefficient against the body.
     contact_offset_m : distance kept outside the body's capsules, metres.
@@ -45,8 +55,10 @@ class DynamicsParams:
     gravity: float = 9.81
     density_kg_m2: float = 0.1
     substeps: int = 20
+    sweeps: int = 2
     stretch_compliance: float = 1e-7
-    bend_compliance: float = 1e-3
+    compression_compliance: float = 1e-7
+    bend_compliance: float = 1.0
     max_strain: float = 0.02
     damping: float = 0.5
     friction: float = 0.4
@@ -54,7 +66,15 @@ class DynamicsParams:
     max_speed_m_s: float = 50.0
 
     def __post_init__(self) -> None:
-        for name in ("gravity", "density_kg_m2", "stretch_compliance", "bend_compliance", "max_strain", "damping"):
+        for name in (
+            "gravity",
+            "density_kg_m2",
+            "stretch_compliance",
+            "compression_compliance",
+            "bend_compliance",
+            "max_strain",
+            "damping",
+        ):
             v = getattr(self, name)
             if not (np.isfinite(v) and v >= 0):
                 raise InputError(f"dynamics parameter {name} must be a finite number >= 0, got {v!r}")
@@ -65,26 +85,116 @@ class DynamicsParams:
 
 
 @dataclass
+class SkinHold:
+    """Cloth vertices held at points of the skin, following the body (a kimono's waist in its obi).
+
+    vertices : (k,) int64 cloth vertices. faces : (k,) int64 skin triangles. bary : (k, 3) float64 barycentric
+    coordinates on them. offset : (k,) float64 metres along the skin's normal there.
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    bary: np.ndarray
+    offset: np.ndarray
+
+    @classmethod
+    def band(
+        cls,
+        positions: np.ndarray,
+        skin: BodyCollider,
+        low: float,
+        high: float,
+        *,
+        on_faces: np.ndarray | None = None,
+        max_distance_m: float = 0.03,
+    ) -> SkinHold:
+        """Hold the cloth vertices (V, 3) whose height is within [low, high] metres and that lie within
+        `max_distance_m` of the skin `skin`, where they are now (an obi from `kitsuke.dressing.kimono.obi_band`: it
+        ties what lies on the waist, not a sleeve hanging beside it). on_faces : (Fb,) bool, the skin triangles
+        that may hold (the trunk's: a sleeve beside the waist is nearest the arm, which must not drag it)."""
+        idx = np.flatnonzero((positions[:, 1] >= low) & (positions[:, 1] <= high))
+        if len(idx):
+            face, _, dist = skin.nearest(positions[idx])
+            keep = dist <= max_distance_m
+            if on_faces is not None:
+                keep &= on_faces[face]
+            idx = idx[keep]
+        if len(idx) == 0:
+            return cls(idx, idx.copy(), np.zeros((0, 3)), np.zeros(0))
+        face, point, _ = skin.nearest(positions[idx])
+        tri = skin.vertices[skin.faces[face]]
+        bary = _barycentric(point, tri)
+        offset = ((positions[idx] - point) * skin.face_normals[face]).sum(axis=1)
+        return cls(idx.astype(np.int64), face.astype(np.int64), bary, offset)
+
+    def targets(self, skin: BodyCollider) -> np.ndarray:
+        """(k, 3) where the held vertices belong on `skin` (the same topology, any pose)."""
+        tri = skin.vertices[skin.faces[self.faces]]
+        return np.einsum("kc,kcd->kd", self.bary, tri) + self.offset[:, None] * skin.face_normals[self.faces]
+
+
+def _barycentric(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """(k, 3) barycentric coordinates of points p (k, 3) on triangles (k, 3, 3) (the points lie on them)."""
+    e1, e2, d = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0], p - tri[:, 0]
+    d11, d12, d22 = (e1 * e1).sum(1), (e1 * e2).sum(1), (e2 * e2).sum(1)
+    d1, d2 = (d * e1).sum(1), (d * e2).sum(1)
+    den = np.maximum(d11 * d22 - d12 * d12, 1e-300)
+    b1 = (d22 * d1 - d12 * d2) / den
+    b2 = (d11 * d2 - d12 * d1) / den
+    return np.column_stack([1.0 - b1 - b2, b1, b2])
+
+
+@dataclass
 class CapsuleBody:
-    """A moving body for the dynamic solver: tapered capsules (`Body.capsule_segments`).
+    """A moving body for the dynamic solver: tapered capsules (`Body.capsule_segments`), and optionally its skin.
 
     ends : (n, 2, 3) float64 metres, now. radii : (n, 2) float64 metres. previous : (n, 2, 3) where the ends were at
     the previous step (the capsules sweep from there to `ends` over the substeps).
+    surface : the body's skin at this step (a `BodyCollider`, with the same capsules) or None. The capsules are
+    inscribed in the limbs; the skin is what cloth rests on. It is collided with once a step, at its last substep
+    (`collide`: layer order, capsules, the surface, the floor), after the capsules kept fast limbs from passing
+    through the cloth during the step.
     """
 
     ends: np.ndarray
     radii: np.ndarray
     previous: np.ndarray = field(default=None)  # type: ignore[assignment]
+    surface: BodyCollider | None = None
+    hold: SkinHold | None = None
+    hold_previous: np.ndarray | None = None
+    hold_now: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         self.ends = np.ascontiguousarray(self.ends, dtype=np.float64).reshape(-1, 2, 3)
         self.radii = np.ascontiguousarray(self.radii, dtype=np.float64).reshape(-1, 2)
         self.previous = self.ends.copy() if self.previous is None else np.asarray(self.previous, np.float64)
 
-    def move_to(self, ends: np.ndarray) -> None:
-        """The capsules' ends (n, 2, 3) at the next step."""
+    @classmethod
+    def of(cls, collider: BodyCollider) -> CapsuleBody:
+        """The moving body of a collider (`BodyCollider.from_body`): its capsules and its skin."""
+        return cls(collider.capsule_ends, collider.capsule_radii, surface=collider)
+
+    def move_to(self, ends: np.ndarray, vertices: np.ndarray | None = None) -> None:
+        """The capsules' ends (n, 2, 3) at the next step, and the skin's vertices (Vb, 3) if it has one."""
         self.previous = self.ends
         self.ends = np.ascontiguousarray(ends, dtype=np.float64).reshape(self.previous.shape)
+        if self.surface is not None:
+            if vertices is None:
+                raise InputError("this body has a skin: give its vertices with the capsules")
+            self.surface = self.surface.moved(vertices, self.ends)
+            if self.hold is not None:
+                self.hold_previous = self.hold_now
+                self.hold_now = self.hold.targets(self.surface)
+
+    def hold_band(self, positions: np.ndarray, low: float, high: float, on_faces: np.ndarray | None = None) -> SkinHold:
+        """Hold the cloth's vertices (V, 3) within [low, high] metres of height to the skin from now on
+        (`SkinHold.band`)."""
+        if self.surface is None:
+            raise InputError("holding cloth to the skin needs a body with a skin (CapsuleBody.of)")
+        self.hold = SkinHold.band(positions, self.surface, low, high, on_faces=on_faces)
+        self.hold_now = self.hold.targets(self.surface)
+        self.hold_previous = self.hold_now
+        return self.hold
 
 
 @dataclass
@@ -98,19 +208,29 @@ class DynamicsData:
     bend_rest: np.ndarray  # (H,) m
 
 
-def dynamics_data(model: ClothModel, params: DynamicsParams) -> DynamicsData:
+def dynamics_data(model: ClothModel, params: DynamicsParams, start: np.ndarray | None = None) -> DynamicsData:
     """Masses (a third of each triangle's rest area times the density to each corner) and constraints: every
     edge at its rest length, and across each interior edge the two opposite vertices at their distance with the
-    two rest triangles unfolded flat."""
+    two rest triangles unfolded flat.
+
+    start : (V, 3) the positions the simulation starts from (a dressed garment), or None: an edge stretched
+    beyond the strain limit there gets the rest length that puts it at the limit, and an edge shorter than its
+    rest length (a fold the dressing pressed, down to −4.9 % on the demo's kimono) its length there, so that the
+    first step does not snap the garment (held to the pattern's lengths, the kimono's hems moved 2-5 cm in it).
+    """
     mass = np.zeros(model.n_vertices)
     np.add.at(mass, model.faces.reshape(-1), np.repeat(model.rest_areas * params.density_kg_m2 / 3.0, 3))
     bend_rest = np.zeros(len(model.hinges))
     for k, ((a, b, c, d), (f0, f1)) in enumerate(zip(model.hinges, model.hinge_faces, strict=True)):
         bend_rest[k] = _flat_distance(model, f0, f1, a, b, c, d)
+    rest = np.array(model.rest_lengths, dtype=np.float64)
+    if start is not None:
+        now = np.linalg.norm(start[model.edges[:, 1]] - start[model.edges[:, 0]], axis=1)
+        rest = np.maximum(np.minimum(rest, now), now / (1.0 + params.max_strain))
     return DynamicsData(
         mass,
         np.ascontiguousarray(model.edges, dtype=np.int64),
-        np.ascontiguousarray(model.rest_lengths, dtype=np.float64),
+        rest,
         np.ascontiguousarray(model.hinges[:, 2:4], dtype=np.int64),
         bend_rest,
     )
@@ -145,6 +265,29 @@ def start(state: ClothState) -> None:
         state.velocities = np.zeros_like(state.positions)
 
 
+def _absorb_push(x: np.ndarray, v: np.ndarray, push: np.ndarray) -> None:
+    """Apply the skin's push-out to the positions without turning it into speed (the skin moves once a step, so a
+    push can be centimetres: as a velocity it would fling the cloth off), and stop what still moved into it."""
+    length = np.linalg.norm(push, axis=1)
+    hit = length > 0
+    if not hit.any():
+        return
+    n = push[hit] / length[hit, None]
+    into = np.minimum((v[hit] * n).sum(axis=1), 0.0)
+    v[hit] -= into[:, None] * n
+    x[hit] += push[hit]
+
+
+def _collide_surface(model: ClothModel, state: ClothState, p: np.ndarray, surface: BodyCollider) -> None:
+    """`collide` on the predicted positions p (in place): the state's contacts keep tracking the skin."""
+    x = state.positions
+    state.positions = p
+    try:
+        collide(model, state, surface)
+    finally:
+        state.positions = x
+
+
 def step(
     model: ClothModel,
     state: ClothState,
@@ -162,7 +305,12 @@ def step(
     data = data or dynamics_data(model, params)
     start(state)
     x, v = state.positions, state.velocities
-    inv_mass = np.where(state.pinned | (data.mass <= 0), 0.0, 1.0 / np.maximum(data.mass, 1e-300))
+    held = body.hold if body is not None and body.hold is not None and len(body.hold.vertices) else None
+    fixed = state.pinned | (data.mass <= 0)
+    if held is not None:
+        fixed = fixed.copy()
+        fixed[held.vertices] = True
+    inv_mass = np.where(fixed, 0.0, 1.0 / np.maximum(data.mass, 1e-300))
     n_sub = int(params.substeps)
     h = dt / n_sub
     keep = max(0.0, 1.0 - params.damping * h)
@@ -170,17 +318,29 @@ def step(
     lam_s = np.zeros(len(data.stretch_rest))
     lam_b = np.zeros(len(data.bend_rest))
     for s in range(n_sub):
+        if held is not None:  # held vertices move with the skin, a substep's share of the step at a time
+            t1 = (s + 1) / n_sub
+            x[held.vertices] = (1.0 - t1) * body.hold_previous + t1 * body.hold_now
         K.predict(x, v, inv_mass, params.gravity, h, p)
         lam_s[:] = 0.0
         lam_b[:] = 0.0
-        K.solve_distances(p, inv_mass, data.stretch_pairs, data.stretch_rest, params.stretch_compliance / h**2, lam_s)
-        K.solve_distances(p, inv_mass, data.bend_pairs, data.bend_rest, params.bend_compliance / h**2, lam_b)
+        stretch, short = params.stretch_compliance / h**2, params.compression_compliance / h**2
+        for _ in range(int(params.sweeps)):
+            K.solve_distances(p, inv_mass, data.stretch_pairs, data.stretch_rest, stretch, short, lam_s)
+        bend = params.bend_compliance / h**2
+        K.solve_distances(p, inv_mass, data.bend_pairs, data.bend_rest, bend, bend, lam_b)
         K.limit_strain(p, inv_mass, data.stretch_pairs, data.stretch_rest, params.max_strain)
         if body is not None and len(body.ends):
             t0, t1 = s / n_sub, (s + 1) / n_sub
             ends = (1.0 - t1) * body.previous + t1 * body.ends
             moved = (t1 - t0) * (body.ends - body.previous)
             K.collide_capsules(p, x, inv_mass, ends, body.radii, moved, params.contact_offset_m, params.friction)
+        if body is not None and body.surface is not None and s == n_sub - 1:
+            before = p.copy()
+            _collide_surface(model, state, p, body.surface)
+            K.finish(x, v, before, inv_mass, h, keep)
+            _absorb_push(x, v, p - before)
+            continue
         K.finish(x, v, p, inv_mass, h, keep)
     if not np.isfinite(x).all():
         raise ComputationError("dynamics", "cloth positions became non-finite", result=state)

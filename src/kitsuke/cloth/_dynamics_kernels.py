@@ -27,10 +27,17 @@ def predict(x: np.ndarray, v: np.ndarray, inv_mass: np.ndarray, gravity: float, 
 
 @njit(cache=True)
 def solve_distances(
-    p: np.ndarray, inv_mass: np.ndarray, pairs: np.ndarray, rest: np.ndarray, alpha: float, lam: np.ndarray
+    p: np.ndarray,
+    inv_mass: np.ndarray,
+    pairs: np.ndarray,
+    rest: np.ndarray,
+    alpha: float,
+    alpha_short: float,
+    lam: np.ndarray,
 ) -> None:
-    """One Gauss-Seidel sweep of XPBD distance constraints |p_a − p_b| = rest, compliance `alpha` already divided
-    by h² (0: rigid); `lam` (K,) holds each constraint's multiplier over the substep."""
+    """One Gauss-Seidel sweep of XPBD distance constraints |p_a − p_b| = rest, compliances already divided by h²:
+    `alpha` for a pair longer than its rest length, `alpha_short` for a shorter one (cloth buckles rather than
+    resisting compression); `lam` (K,) holds each constraint's multiplier over the substep."""
     for k in range(pairs.shape[0]):
         a, b = pairs[k, 0], pairs[k, 1]
         w = inv_mass[a] + inv_mass[b]
@@ -41,7 +48,8 @@ def solve_distances(
         if d < 1e-12:
             continue
         c = d - rest[k]
-        dl = (-c - alpha * lam[k]) / (w + alpha)
+        al = alpha if c > 0.0 else alpha_short
+        dl = (-c - al * lam[k]) / (w + al)
         lam[k] += dl
         s = dl / d
         p[a, 0] += inv_mass[a] * s * dx

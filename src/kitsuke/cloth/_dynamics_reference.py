@@ -16,7 +16,7 @@ def predict(x, v, inv_mass, gravity, h):
     return p, v
 
 
-def solve_distances(p, inv_mass, pairs, rest, alpha, lam):
+def solve_distances(p, inv_mass, pairs, rest, alpha, alpha_short, lam):
     p, lam = p.copy(), lam.copy()
     for k, (a, b) in enumerate(pairs):
         w = inv_mass[a] + inv_mass[b]
@@ -24,7 +24,8 @@ def solve_distances(p, inv_mass, pairs, rest, alpha, lam):
         d = np.linalg.norm(diff)
         if w == 0 or d < 1e-12:
             continue
-        dl = (-(d - rest[k]) - alpha * lam[k]) / (w + alpha)  # Macklin et al. 2016, eq. 18
+        al = alpha if d > rest[k] else alpha_short
+        dl = (-(d - rest[k]) - al * lam[k]) / (w + al)  # Macklin et al. 2016, eq. 18
         lam[k] += dl
         n = diff / d
         p[a] = p[a] + inv_mass[a] * dl * n
