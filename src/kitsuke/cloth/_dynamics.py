@@ -11,8 +11,10 @@ Each step of `dt` seconds runs `DynamicsParams.substeps` substeps of h = dt / su
    capsules move a substep's share of their frame motion each substep (sub-stepped, so a fast leg does not pass
    through the cloth in one frame);
 5. velocities from the positions' change, damped by `damping` per second;
-6. at the last substep, with a skin (`CapsuleBody.surface`): `collide` (layer order, capsules, the skin, the
-   floor) moves the cloth out onto the skin, and only the motion into the skin is taken out of the velocities.
+6. with a skin (`CapsuleBody.surface`): every substep, each cloth vertex near the skin stays outside the plane
+   of its tracked skin point (moving with the skin over the step, with friction); at the last substep `collide`
+   (layer order, capsules, the skin, the floor) moves the cloth out onto the skin and refreshes the tracking,
+   and only the motion into the skin is taken out of the velocities.
 Vertices held to the skin (`SkinHold`: a kimono's waist in its obi) move with it, a substep's share at a time.
 Small steps with one sweep each converge better than few steps with many sweeps (Macklin et al., "Small Steps in
 Physics Simulation", 2019), and keep the solver stable at dt = 1/30 s.
@@ -26,7 +28,7 @@ import numpy as np
 
 from ..errors import ComputationError, InputError
 from . import _dynamics_kernels as K
-from ._collide import BodyCollider, collide
+from ._collide import BodyCollider, collide, track
 from ._model import ClothModel, ClothState
 
 
@@ -163,6 +165,7 @@ class CapsuleBody:
     hold: SkinHold | None = None
     hold_previous: np.ndarray | None = None
     hold_now: np.ndarray | None = None
+    skin_previous: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         self.ends = np.ascontiguousarray(self.ends, dtype=np.float64).reshape(-1, 2, 3)
@@ -181,6 +184,7 @@ class CapsuleBody:
         if self.surface is not None:
             if vertices is None:
                 raise InputError("this body has a skin: give its vertices with the capsules")
+            self.skin_previous = self.surface.vertices
             self.surface = self.surface.moved(vertices, self.ends)
             if self.hold is not None:
                 self.hold_previous = self.hold_now
@@ -286,6 +290,28 @@ def _absorb_push(x: np.ndarray, v: np.ndarray, push: np.ndarray) -> None:
     x[hit] += push[hit]
 
 
+def _skin_planes(model: ClothModel, state: ClothState, body: CapsuleBody):
+    """The skin under each cloth vertex tracked near it by the last collision, as planes for every substep: (index
+    (k,), point at the step's start (k, 3), point at its end (k, 3), unit normal at its end (k, 3)), or None. The
+    full collision runs once a step; without these planes the weight of a garment hanging from the shoulders
+    sank it a centimetre and more into them within a step (pushed back at its end, it flew off)."""
+    c = state.contacts
+    if not (c.face >= 0).any():  # the first step: find the skin under the cloth
+        track(model, state, body.surface)
+    reach = 4.0 * model.params.contact_distance_m
+    index = np.flatnonzero((c.face >= 0) & (c.distance < reach))
+    if len(index) == 0:
+        return None
+    skin = body.surface
+    faces = skin.faces[c.face[index]]
+    bary = c.bary[index]
+    end = np.einsum("kc,kcd->kd", bary, skin.vertices[faces])
+    before = skin.vertices if body.skin_previous is None else body.skin_previous
+    start = np.einsum("kc,kcd->kd", bary, before[faces])
+    normals = np.ascontiguousarray(skin.face_normals[c.face[index]])
+    return index.astype(np.int64), np.ascontiguousarray(start), np.ascontiguousarray(end), normals
+
+
 def _collide_surface(model: ClothModel, state: ClothState, p: np.ndarray, surface: BodyCollider) -> None:
     """`collide` on the predicted positions p (in place): the state's contacts keep tracking the skin."""
     x = state.positions
@@ -322,6 +348,7 @@ def step(
     n_sub = int(params.substeps)
     h = dt / n_sub
     keep = max(0.0, 1.0 - params.damping * h)
+    planes = _skin_planes(model, state, body) if body is not None and body.surface is not None else None
     p = np.empty_like(x)
     lam_s = np.zeros(len(data.stretch_rest))
     lam_b = np.zeros(len(data.bend_rest))
@@ -343,6 +370,15 @@ def step(
             ends = (1.0 - t1) * body.previous + t1 * body.ends
             moved = (t1 - t0) * (body.ends - body.previous)
             K.collide_capsules(p, x, inv_mass, ends, body.radii, moved, params.contact_offset_m, params.friction)
+        if planes is not None:
+            index, plane_start, plane_end, normals = planes
+            t0, t1 = s / n_sub, (s + 1) / n_sub
+            points = (1.0 - t1) * plane_start + t1 * plane_end
+            K.collide_planes(
+                p, x, inv_mass, index, points, normals, (t1 - t0) * (plane_end - plane_start),
+                model.params.contact_offset_m,
+                params.friction,
+            )  # fmt: skip
         if body is not None and body.surface is not None and s == n_sub - 1:
             before = p.copy()
             _collide_surface(model, state, p, body.surface)

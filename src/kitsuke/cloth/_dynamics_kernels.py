@@ -160,3 +160,45 @@ def finish(x: np.ndarray, v: np.ndarray, p: np.ndarray, inv_mass: np.ndarray, h:
         for c in range(3):
             v[i, c] = keep * (p[i, c] - x[i, c]) / h
             x[i, c] = p[i, c]
+
+
+@njit(cache=True)
+def collide_planes(
+    p: np.ndarray,
+    x: np.ndarray,
+    inv_mass: np.ndarray,
+    index: np.ndarray,
+    points: np.ndarray,
+    normals: np.ndarray,
+    moved: np.ndarray,
+    offset: float,
+    friction: float,
+) -> int:
+    """Keep the vertices `index` (k,) on the outer side of their skin planes (k, 3) points with unit normals, plus
+    `offset` metres, with Coulomb friction against the plane's motion this substep `moved` (k, 3). Returns the
+    number pushed."""
+    pushed = 0
+    for j in range(index.shape[0]):
+        i = index[j]
+        if inv_mass[i] == 0.0:
+            continue
+        nx, ny, nz = normals[j, 0], normals[j, 1], normals[j, 2]
+        d = (p[i, 0] - points[j, 0]) * nx + (p[i, 1] - points[j, 1]) * ny + (p[i, 2] - points[j, 2]) * nz - offset
+        if d >= 0.0:
+            continue
+        p[i, 0] -= d * nx
+        p[i, 1] -= d * ny
+        p[i, 2] -= d * nz
+        rx = p[i, 0] - x[i, 0] - moved[j, 0]
+        ry = p[i, 1] - x[i, 1] - moved[j, 1]
+        rz = p[i, 2] - x[i, 2] - moved[j, 2]
+        rn = rx * nx + ry * ny + rz * nz
+        tx, ty, tz = rx - rn * nx, ry - rn * ny, rz - rn * nz
+        tl = math.sqrt(tx * tx + ty * ty + tz * tz)
+        if tl > 0.0:
+            cut = min(1.0, -friction * d / tl)
+            p[i, 0] -= cut * tx
+            p[i, 1] -= cut * ty
+            p[i, 2] -= cut * tz
+        pushed += 1
+    return pushed
