@@ -224,3 +224,31 @@ def test_a_skirt_held_at_the_waist_follows_a_moving_body():
         assert state.contacts.distance.min() > -0.002
     np.testing.assert_allclose(state.positions[hold.vertices], hold.targets(body.surface), atol=1e-9)
     assert np.isfinite(state.positions).all()
+
+
+def test_a_sheet_draped_over_a_bar_rests_on_it():
+    """A sheet dropped onto a horizontal bar (a closed skin, no capsules) drapes over it and rests on it: the skin
+    planes keep every vertex outside during the substeps, not only at the step's end."""
+    import trimesh
+
+    from kitsuke.cloth import BodyCollider
+    from kitsuke.geometry import TriMesh
+
+    bar = trimesh.creation.cylinder(radius=0.05, height=1.0, sections=48)  # along Z
+    skin = BodyCollider.from_mesh(TriMesh(np.asarray(bar.vertices), np.asarray(bar.faces)))
+    uv, faces = grid_sheet(21, 11, 0.02)
+    model = ClothModel.from_corners(faces, uv[faces])
+    pos = np.column_stack([uv[:, 0] - 0.2, np.full(len(uv), 0.06), uv[:, 1] - 0.1])  # 1 cm above the bar
+    state = ClothState.new(model, pos)
+    body = CapsuleBody.of(skin)
+    params = DynamicsParams(damping=2.0)
+    data = dynamics_data(model, params)
+    for _ in range(60):
+        body.move_to(np.zeros((0, 2, 3)), skin.vertices)
+        step(model, state, body, 1 / 30, params, data)
+    # draped: the sheet's sides hang well below the bar's top, its middle rests on the bar
+    assert state.positions[:, 1].min() < -0.05
+    middle = np.isclose(uv[:, 0], 0.2)
+    assert 0.05 <= state.positions[middle, 1].min() < 0.06
+    radial = np.linalg.norm(state.positions[:, :2], axis=1)
+    assert radial.min() > 0.05 - 0.001  # nothing inside the bar
