@@ -92,12 +92,18 @@ class SkinHold:
 
     vertices : (k,) int64 cloth vertices. faces : (k,) int64 skin triangles. bary : (k, 3) float64 barycentric
     coordinates on them. offset : (k,) float64 metres along the skin's normal there.
+    rest : (k, 3) the held vertices where they were held, and rest_skin : (k, 3) their skin points then, or None:
+    then the band moves rigidly, by the rotation and translation that best carry the skin points to where they
+    are now (an obi is stiff: held to each skin point, its edges stretched up to 50 % with the skin of a
+    walking waist).
     """
 
     vertices: np.ndarray
     faces: np.ndarray
     bary: np.ndarray
     offset: np.ndarray
+    rest: np.ndarray | None = None
+    rest_skin: np.ndarray | None = None
 
     @classmethod
     def band(
@@ -109,11 +115,14 @@ class SkinHold:
         *,
         on_faces: np.ndarray | None = None,
         max_distance_m: float = 0.03,
+        rigid: bool = True,
     ) -> SkinHold:
         """Hold the cloth vertices (V, 3) whose height is within [low, high] metres and that lie within
         `max_distance_m` of the skin `skin`, where they are now (an obi from `kitsuke.dressing.kimono.obi_band`: it
         ties what lies on the waist, not a sleeve hanging beside it). on_faces : (Fb,) bool, the skin triangles
-        that may hold (the trunk's: a sleeve beside the waist is nearest the arm, which must not drag it)."""
+        that may hold (the trunk's: a sleeve beside the waist is nearest the arm, which must not drag it).
+        rigid : the band moves as one rigid piece with its skin points (see the class), else each vertex with its
+        own skin point."""
         idx = np.flatnonzero((positions[:, 1] >= low) & (positions[:, 1] <= high))
         if len(idx):
             face, _, dist = skin.nearest(positions[idx])
@@ -127,12 +136,24 @@ class SkinHold:
         tri = skin.vertices[skin.faces[face]]
         bary = _barycentric(point, tri)
         offset = ((positions[idx] - point) * skin.face_normals[face]).sum(axis=1)
-        return cls(idx.astype(np.int64), face.astype(np.int64), bary, offset)
+        held = cls(idx.astype(np.int64), face.astype(np.int64), bary, offset)
+        if rigid:
+            held.rest, held.rest_skin = positions[idx].copy(), held.skin_points(skin)
+        return held
+
+    def skin_points(self, skin: BodyCollider) -> np.ndarray:
+        """(k, 3) the held vertices' skin points on `skin`."""
+        return np.einsum("kc,kcd->kd", self.bary, skin.vertices[skin.faces[self.faces]])
 
     def targets(self, skin: BodyCollider) -> np.ndarray:
         """(k, 3) where the held vertices belong on `skin` (the same topology, any pose)."""
-        tri = skin.vertices[skin.faces[self.faces]]
-        return np.einsum("kc,kcd->kd", self.bary, tri) + self.offset[:, None] * skin.face_normals[self.faces]
+        points = self.skin_points(skin)
+        if self.rest is not None:
+            a, b = self.rest_skin - self.rest_skin.mean(axis=0), points - points.mean(axis=0)
+            u, _, vt = np.linalg.svd(b.T @ a)
+            r = u @ np.diag([1.0, 1.0, np.sign(np.linalg.det(u @ vt)) or 1.0]) @ vt
+            return (self.rest - self.rest_skin.mean(axis=0)) @ r.T + points.mean(axis=0)
+        return points + self.offset[:, None] * skin.face_normals[self.faces]
 
 
 def _barycentric(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
