@@ -123,3 +123,8 @@ def check(name: str, value: float, what: str, path: str | os.PathLike[str] | Non
             f"{what}, over the limit of {shown} (raise it with --limit {name}=N or KITSUKE_LIMIT_{name.upper()}=N)",
             path,
         )
+
+
+def check_image(width: int, height: int, path: str | os.PathLike[str] | None = None) -> None:
+    """`check` of an image's or video frame's size against `image_mpx`."""
+    check("image_mpx", width * height / 1e6, f"the image is {width:,}×{height:,} pixels", path)

@@ -9,10 +9,10 @@ import pytest
 from scipy.optimize import brentq
 
 from kitsuke.cloth import (
-    CapsuleBody,
     ClothModel,
     ClothState,
     DynamicsParams,
+    MovingBody,
     dynamics_data,
     grid_sheet,
     grid_tube,
@@ -166,7 +166,7 @@ def test_fast_random_limb_motion_stays_finite_and_outside():
     pos = np.concatenate([ring + [0.0, 1.0 - j * spacing, 0.0] for j in range(n_rows)])
     state = ClothState.new(model, pos, pinned=np.arange(len(pos)) < n_around)
     top = np.array([0.0, 1.0, 0.0])
-    body = CapsuleBody(np.array([[top, [0.0, 0.6, 0.0]]]), np.array([[0.05, 0.04]]))
+    body = MovingBody(np.array([[top, [0.0, 0.6, 0.0]]]), np.array([[0.05, 0.04]]))
     params = DynamicsParams()
     data = dynamics_data(model, params)
     rng = np.random.default_rng(3)
@@ -194,7 +194,7 @@ def test_divergence_is_a_computation_error():
 def test_a_skirt_held_at_the_waist_follows_a_moving_body():
     """A tube held at its top band to a cylinder's skin (`SkinHold`, an obi), the cylinder rising 20 cm and
     swaying over 30 frames: the held band stays on its skin points, and no cloth goes into the skin (the surface
-    is collided with once a frame, `CapsuleBody.surface`)."""
+    is collided with once a frame, `MovingBody.surface`)."""
     import trimesh
 
     from kitsuke.cloth import BodyCollider
@@ -212,7 +212,7 @@ def test_a_skirt_held_at_the_waist_follows_a_moving_body():
     ring = np.column_stack([radius * np.cos(ang), np.zeros(n_around), radius * np.sin(ang)])
     pos = np.concatenate([ring + [0.0, 0.3 - j * spacing, 0.0] for j in range(n_rows)])
     state = ClothState.new(model, pos)
-    body = CapsuleBody.of(skin)
+    body = MovingBody.of(skin)
     hold = body.hold_band(pos, 0.27, 0.31)
     assert len(hold.vertices) == 2 * n_around
     params = DynamicsParams()
@@ -240,7 +240,7 @@ def test_a_sheet_draped_over_a_bar_rests_on_it():
     model = ClothModel.from_corners(faces, uv[faces])
     pos = np.column_stack([uv[:, 0] - 0.2, np.full(len(uv), 0.06), uv[:, 1] - 0.1])  # 1 cm above the bar
     state = ClothState.new(model, pos)
-    body = CapsuleBody.of(skin)
+    body = MovingBody.of(skin)
     params = DynamicsParams(damping=2.0)
     data = dynamics_data(model, params)
     for _ in range(60):

@@ -13,7 +13,7 @@ Typical use::
 small move down, and collision pushes the cloth out of the body. Constants live in `ClothParams`.
 
 `step(model, state, body, dt)` is: XPBD dynamics on the same model and state (with velocities) against a moving
-`CapsuleBody`; constants in `DynamicsParams` (see `_dynamics.py`).
+`MovingBody`; constants in `DynamicsParams` (see `_dynamics.py`).
 """
 
 from ._collide import (
@@ -26,7 +26,7 @@ from ._collide import (
     track,
     vertex_active,
 )
-from ._dynamics import CapsuleBody, DynamicsData, DynamicsParams, SkinHold, dynamics_data, step
+from ._dynamics import DynamicsData, DynamicsParams, MovingBody, SkinHold, dynamics_data, step
 from ._lengths import LengthStats, restore_lengths
 from ._model import ClothModel, ClothParams, ClothState, Contacts, locality_order
 from ._polish import PolishStats, RefinedPolish, bending_stencil, compile_polish, polish, polish_refined
@@ -39,7 +39,6 @@ from ._untangle import UntangleStats, folded_faces, grow_region, untangle
 
 __all__ = [
     "BodyCollider",
-    "CapsuleBody",
     "DynamicsData",
     "DynamicsParams",
     "SkinHold",
@@ -52,6 +51,7 @@ __all__ = [
     "Contacts",
     "LayerPlanes",
     "LengthStats",
+    "MovingBody",
     "PolishStats",
     "RefinedPolish",
     "Refinement",

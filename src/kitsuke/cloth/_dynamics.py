@@ -11,7 +11,7 @@ Each step of `dt` seconds runs `DynamicsParams.substeps` substeps of h = dt / su
    capsules move a substep's share of their frame motion each substep (sub-stepped, so a fast leg does not pass
    through the cloth in one frame);
 5. velocities from the positions' change, damped by `damping` per second;
-6. with a skin (`CapsuleBody.surface`): every substep, each cloth vertex near the skin stays outside the plane
+6. with a skin (`MovingBody.surface`): every substep, each cloth vertex near the skin stays outside the plane
    of its tracked skin point (moving with the skin over the step, with friction); at the last substep `collide`
    (layer order, capsules, the skin, the floor) moves the cloth out onto the skin and refreshes the tracking,
    and only the motion into the skin is taken out of the velocities.
@@ -168,8 +168,8 @@ def _barycentric(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
 
 
 @dataclass
-class CapsuleBody:
-    """A moving body for the dynamic solver: tapered capsules (`Body.capsule_segments`), and optionally its skin.
+class MovingBody:
+    """A moving body for the dynamic solver: its tapered capsules (`Body.capsule_segments`), and optionally its skin
 
     ends : (n, 2, 3) float64 metres, now. radii : (n, 2) float64 metres. previous : (n, 2, 3) where the ends were at
     the previous step (the capsules sweep from there to `ends` over the substeps).
@@ -194,7 +194,7 @@ class CapsuleBody:
         self.previous = self.ends.copy() if self.previous is None else np.asarray(self.previous, np.float64)
 
     @classmethod
-    def of(cls, collider: BodyCollider) -> CapsuleBody:
+    def of(cls, collider: BodyCollider) -> MovingBody:
         """The moving body of a collider (`BodyCollider.from_body`): its capsules and its skin."""
         return cls(collider.capsule_ends, collider.capsule_radii, surface=collider)
 
@@ -215,7 +215,7 @@ class CapsuleBody:
         """Hold the cloth's vertices (V, 3) within [low, high] metres of height to the skin from now on
         (`SkinHold.band`)."""
         if self.surface is None:
-            raise InputError("holding cloth to the skin needs a body with a skin (CapsuleBody.of)")
+            raise InputError("holding cloth to the skin needs a body with a skin (MovingBody.of)")
         self.hold = SkinHold.band(positions, self.surface, low, high, on_faces=on_faces)
         self.hold_now = self.hold.targets(self.surface)
         self.hold_previous = self.hold_now
@@ -311,7 +311,7 @@ def _absorb_push(x: np.ndarray, v: np.ndarray, push: np.ndarray) -> None:
     x[hit] += push[hit]
 
 
-def _skin_planes(model: ClothModel, state: ClothState, body: CapsuleBody):
+def _skin_planes(model: ClothModel, state: ClothState, body: MovingBody):
     """The skin under each cloth vertex tracked near it by the last collision, as planes for every substep: (index
     (k,), point at the step's start (k, 3), point at its end (k, 3), unit normal at its end (k, 3)), or None. The
     full collision runs once a step; without these planes the weight of a garment hanging from the shoulders
@@ -346,7 +346,7 @@ def _collide_surface(model: ClothModel, state: ClothState, p: np.ndarray, surfac
 def step(
     model: ClothModel,
     state: ClothState,
-    body: CapsuleBody | None,
+    body: MovingBody | None,
     dt: float,
     params: DynamicsParams | None = None,
     data: DynamicsData | None = None,

@@ -404,24 +404,9 @@ def correct_frames(
                 status[f, p] = INSIDE
                 if prev_valid:
                     _ease_pair(
-                        q,
-                        positions,
-                        out,
-                        f,
-                        p,
-                        target,
-                        angle,
-                        axes,
-                        status,
-                        start_joints,
-                        moved,
-                        pair_joints,
-                        rules,
-                        tmp2,
-                        pt2,
-                        e2,
-                        -1,
-                    )
+                        q, positions, out, f, p, target, angle, axes, status, start_joints, moved, pair_joints, rules,
+                        tmp2, pt2, e2, -1,
+                    )  # fmt: skip
                 continue
             if prev_valid:
                 region(out[f - 1], jl, jr, hip_l, hip_r, tt[p], ee[p], area[p], k_prev)
@@ -453,24 +438,9 @@ def correct_frames(
                 status[f, p] = ALREADY_INSIDE
                 if prev_valid:
                     _ease_pair(
-                        q,
-                        positions,
-                        out,
-                        f,
-                        p,
-                        target,
-                        angle,
-                        axes,
-                        status,
-                        start_joints,
-                        moved,
-                        pair_joints,
-                        rules,
-                        tmp2,
-                        pt2,
-                        e2,
-                        -1,
-                    )
+                        q, positions, out, f, p, target, angle, axes, status, start_joints, moved, pair_joints, rules,
+                        tmp2, pt2, e2, -1,
+                    )  # fmt: skip
                 continue
             # w: horizontal direction from the target toward its closest point on the ellipse of K'
             dx, dz = x - k_prev[0], z - k_prev[1]
@@ -657,24 +627,9 @@ def correct_frames(
                     residual[f, p] = best_d
                     if prev_valid:
                         _ease_pair(
-                            q,
-                            positions,
-                            out,
-                            f,
-                            p,
-                            target,
-                            angle,
-                            axes,
-                            status,
-                            start_joints,
-                            moved,
-                            pair_joints,
-                            rules,
-                            tmp2,
-                            pt2,
-                            e2,
-                            -1,
-                        )
+                            q, positions, out, f, p, target, angle, axes, status, start_joints, moved, pair_joints,
+                            rules, tmp2, pt2, e2, -1,
+                        )  # fmt: skip
                     continue
                 status[f, p] = LIMITED if (any_inside or kbest < 0) else CLOSEST
             # rotate the segment and everything below it about the axis through the start joint

@@ -220,7 +220,7 @@ def open_video(path: str | os.PathLike[str]) -> tuple[Any, float, int, tuple[int
     if not (fps > 0 and np.isfinite(fps)):
         fps = 30.0  # containers without a frame rate: assume 30 and say so in the source
     try:
-        _check_image_size(*size, p)
+        limits.check_image(*size, p)
         limits.check("frames", n, f"the video declares {n:,} frames", p)
     except InputError:
         cap.release()
@@ -298,10 +298,6 @@ def extract_video(
     return PoseSequence(positions=pos, valid=valid, times=times, fps=fps / stride, source=source, image=img)
 
 
-def _check_image_size(width: int, height: int, path: Path) -> None:
-    limits.check("image_mpx", width * height / 1e6, f"the image is {width:,}×{height:,} pixels", path)
-
-
 def _read_image(path: Path) -> np.ndarray:
     try:  # the header's size, before decoding a picture that would not fit in memory
         from PIL import Image
@@ -311,7 +307,7 @@ def _read_image(path: Path) -> np.ndarray:
     except Exception:  # noqa: BLE001 - not an image Pillow knows: OpenCV decides below
         size = None
     if size is not None:
-        _check_image_size(*size, path)
+        limits.check_image(*size, path)
     cv2 = _cv2()
     data = np.fromfile(str(path), dtype=np.uint8)
     bgr = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
@@ -384,7 +380,7 @@ def _read_size(path: Path) -> tuple[int, int]:
     except Exception:  # noqa: BLE001 - fall back to a full decode, which raises InputError if unreadable
         bgr = _read_image(path)
         return bgr.shape[1], bgr.shape[0]
-    _check_image_size(*size, path)
+    limits.check_image(*size, path)
     return size
 
 

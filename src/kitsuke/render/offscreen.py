@@ -371,7 +371,7 @@ def read_texture(path: str | os.PathLike[str]) -> np.ndarray:
     try:
         with Image.open(p) as im:
             w, h = im.size
-            limits.check("image_mpx", w * h / 1e6, f"the image is {w:,}×{h:,} pixels", p)
+            limits.check_image(w, h, p)
             im = im.convert("RGBA" if im.mode in ("RGBA", "LA", "PA") else "RGB")
             return np.asarray(im, dtype=np.uint8)
     except InputError:
