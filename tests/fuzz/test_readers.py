@@ -80,7 +80,7 @@ def test_huge_circle_edge_is_refused_quickly(worker, large_arc):
     outcome = worker.run("pattern-garmentcode", data)
     if large_arc:
         assert outcome.status == "input-error", outcome.detail
-        assert "over the limit of 10 m" in outcome.detail and "--limit edge_m" in outcome.detail
+        assert "over the limit of 50 m" in outcome.detail and "--limit edge_m" in outcome.detail
     else:
         assert outcome.fine, outcome.detail
     assert outcome.seconds < 2.0
