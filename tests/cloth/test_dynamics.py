@@ -21,6 +21,7 @@ from kitsuke.cloth import (
 from kitsuke.cloth import _dynamics_kernels as K
 from kitsuke.cloth import _dynamics_reference as R
 from kitsuke.errors import ComputationError
+from kitsuke.metrics import strain as measure_strain
 
 
 @pytest.fixture
@@ -156,7 +157,10 @@ def test_energy_does_not_grow_without_input():
 
 def test_fast_random_limb_motion_stays_finite_and_outside():
     """A skirt-like tube held at the waist around a leg capsule that jumps to a random place every frame (up to 25
-    cm a frame: 7.5 m/s) for 1,000 frames at 1/30 s: never non-finite, never inside the leg."""
+    cm a frame: 7.5 m/s) for 1,000 frames at 1/30 s: never non-finite, the leg more than 2 mm through the cloth in
+    at most 1 % of the frames, and no edge stretched by half (the strain limit comes after the collisions: where
+    the tube cannot make room that fast, it gives way a little rather than tearing; with collision last it stayed
+    outside but its edges stretched to 4.7 times their length)."""
     n_around, n_rows, spacing = 24, 16, 0.025
     faces, corners, _ = grid_tube(n_around, n_rows, spacing)
     model = ClothModel.from_corners(faces, corners)
@@ -170,7 +174,7 @@ def test_fast_random_limb_motion_stays_finite_and_outside():
     params = DynamicsParams()
     data = dynamics_data(model, params)
     rng = np.random.default_rng(3)
-    worst = -np.inf
+    inside, strain = [], []
     for _ in range(1000):
         tip = top + [rng.uniform(-0.25, 0.25), rng.uniform(-0.45, -0.25), rng.uniform(-0.25, 0.25)]
         body.move_to(np.array([[top, tip]]))
@@ -178,10 +182,12 @@ def test_fast_random_limb_motion_stays_finite_and_outside():
         a, b = body.ends[0]
         u = b - a
         t = np.clip((state.positions - a) @ u / (u @ u), 0, 1)
-        inside = 0.05 + t * (0.04 - 0.05) - np.linalg.norm(state.positions - (a + t[:, None] * u), axis=1)
-        worst = max(worst, float(inside.max()))
+        depth = 0.05 + t * (0.04 - 0.05) - np.linalg.norm(state.positions - (a + t[:, None] * u), axis=1)
+        inside.append(float(depth.max()))
+        strain.append(measure_strain(state.positions, model.edges, model.rest_lengths).stretched)
     assert np.isfinite(state.positions).all()
-    assert worst <= 0.0
+    assert np.mean(np.array(inside) > 0.002) <= 0.01
+    assert max(strain) < 0.5
 
 
 def test_divergence_is_a_computation_error():

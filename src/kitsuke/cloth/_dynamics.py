@@ -6,12 +6,13 @@ Each step of `dt` seconds runs `DynamicsParams.substeps` substeps of h = dt / su
 2. one Gauss-Seidel sweep of stretch constraints (every mesh edge keeps its rest length, compliance
    `stretch_compliance`) and of bending constraints (the two vertices opposite each interior edge keep their flat
    rest distance, compliance `bend_compliance`): XPBD, so stiffness does not depend on h or the sweep count;
-3. the strain limit: no edge longer than (1 + `max_strain`) its rest length;
-4. collision with the moving body's capsules, pushed `contact_offset_m` outside with Coulomb friction; the
-   capsules move a substep's share of their frame motion each substep (sub-stepped, so a fast leg does not pass
-   through the cloth in one frame);
-5. velocities from the positions' change, damped by `damping` per second;
-6. with a skin (`MovingBody.surface`): every substep, each cloth vertex near the skin stays outside the plane
+3. `contact_rounds` rounds of: collision with the moving body's capsules, pushed `contact_offset_m` outside with
+   Coulomb friction (the capsules move a substep's share of their frame motion each substep: sub-stepped, so a
+   fast leg does not pass through the cloth in one frame), then the strain limit: no edge longer than
+   (1 + `max_strain`) its rest length. Where the two conflict (a leg beyond the reach of the cloth around it,
+   cloth caught between arm and chest) the cloth ends the substep a little way into the body rather than torn;
+4. velocities from the positions' change, damped by `damping` per second;
+5. with a skin (`MovingBody.surface`): in each round of 3, each cloth vertex near the skin stays outside the plane
    of its tracked skin point (moving with the skin over the step, with friction); at the last substep `collide`
    (layer order, capsules, the skin, the floor) moves the cloth out onto the skin and refreshes the tracking,
    and only the motion into the skin is taken out of the velocities.
@@ -45,6 +46,11 @@ class DynamicsParams:
         pushing back.
     bend_compliance : m/N of the bending constraints; larger folds more easily. A vertex of 2 cm silk weighs 40 mg
         (0.4 mN): at 1 m/N a 1 mm bend pushes back with 1 mN, so silk drapes.
+    contact_rounds : rounds of collision then strain limit per substep. The strain limit comes last, so that a
+        body the cloth cannot make room for pushes into it rather than tearing it; more rounds let the cloth carry
+        the push further. A tube around a leg jumping up to 25 cm a frame, over 1,000 frames: 1 round, edges up
+        to 99 % stretched and the leg 38 mm through it at worst; 4 rounds, 46 % and 2.5 mm (collision last, as
+        before: 371 % and never through).
     max_strain : the strain limit: no edge longer than (1 + this) times its rest length (silk barely stretches).
         A dressed garment can start above it (the dressing's target is 5 %): `dynamics_data(..., start=)` then
         lengthens those edges' rest lengths, so that the first step does not snap the garment shorter.
@@ -62,6 +68,7 @@ class DynamicsParams:
     compression_compliance: float = 1e-7
     bend_compliance: float = 1.0
     max_strain: float = 0.02
+    contact_rounds: int = 4
     damping: float = 0.5
     friction: float = 0.4
     contact_offset_m: float = 0.004
@@ -82,8 +89,10 @@ class DynamicsParams:
                 raise InputError(f"dynamics parameter {name} must be a finite number >= 0, got {v!r}")
         if not self.density_kg_m2 > 0:
             raise InputError("dynamics parameter density_kg_m2 must be positive")
-        if int(self.substeps) != self.substeps or self.substeps < 1:
-            raise InputError(f"dynamics parameter substeps must be a positive integer, got {self.substeps!r}")
+        for name in ("substeps", "sweeps", "contact_rounds"):
+            v = getattr(self, name)
+            if int(v) != v or v < 1:
+                raise InputError(f"dynamics parameter {name} must be a positive integer, got {v!r}")
 
 
 @dataclass
@@ -385,21 +394,21 @@ def step(
             K.solve_distances(p, inv_mass, data.stretch_pairs, data.stretch_rest, stretch, short, lam_s)
         bend = params.bend_compliance / h**2
         K.solve_distances(p, inv_mass, data.bend_pairs, data.bend_rest, bend, bend, lam_b)
-        K.limit_strain(p, inv_mass, data.stretch_pairs, data.stretch_rest, params.max_strain)
-        if body is not None and len(body.ends):
-            t0, t1 = s / n_sub, (s + 1) / n_sub
-            ends = (1.0 - t1) * body.previous + t1 * body.ends
-            moved = (t1 - t0) * (body.ends - body.previous)
-            K.collide_capsules(p, x, inv_mass, ends, body.radii, moved, params.contact_offset_m, params.friction)
-        if planes is not None:
-            index, plane_start, plane_end, normals = planes
-            t0, t1 = s / n_sub, (s + 1) / n_sub
-            points = (1.0 - t1) * plane_start + t1 * plane_end
-            K.collide_planes(
-                p, x, inv_mass, index, points, normals, (t1 - t0) * (plane_end - plane_start),
-                model.params.contact_offset_m,
-                params.friction,
-            )  # fmt: skip
+        t0, t1 = s / n_sub, (s + 1) / n_sub
+        for _ in range(int(params.contact_rounds)):
+            if body is not None and len(body.ends):
+                ends = (1.0 - t1) * body.previous + t1 * body.ends
+                moved = (t1 - t0) * (body.ends - body.previous)
+                K.collide_capsules(p, x, inv_mass, ends, body.radii, moved, params.contact_offset_m, params.friction)
+            if planes is not None:
+                index, plane_start, plane_end, normals = planes
+                points = (1.0 - t1) * plane_start + t1 * plane_end
+                K.collide_planes(
+                    p, x, inv_mass, index, points, normals, (t1 - t0) * (plane_end - plane_start),
+                    model.params.contact_offset_m,
+                    params.friction,
+                )  # fmt: skip
+            K.limit_strain(p, inv_mass, data.stretch_pairs, data.stretch_rest, params.max_strain)
         if body is not None and body.surface is not None and s == n_sub - 1:
             before = p.copy()
             _collide_surface(model, state, p, body.surface)
