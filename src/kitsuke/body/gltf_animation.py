@@ -4,6 +4,11 @@ One mesh skinned to the 23 joints of `kitsuke.skeleton` (four weights per vertex
 glTF viewers and three.js read), the joints as a node tree whose rest pose is the body's (every joint's rest
 orientation is the world's, so a node's translation is its rest bone), and one animation: each joint's rotation
 relative to its parent and the root's translation, per frame, linearly interpolated (quaternions slerped).
+
+Optionally a second mesh that moves by itself (a simulated garment, `MorphMesh`): one morph target per frame
+(positions and normals as offsets from its first frame), and the same animation sets the weights so that frame k
+shows target k fully, linearly blended in between. Blender imports the targets as shape keys with their animation,
+and three.js plays them (morph targets kept in a texture, so their number has no small limit).
 """
 
 from __future__ import annotations
@@ -11,16 +16,31 @@ from __future__ import annotations
 import json
 import os
 import struct
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from .._files import atomic_path
+from ..geometry import TriMesh
 from ..skeleton import JOINTS, PARENT_INDEX
 from .animate import BodyAnimation
 
 _FLOAT, _USHORT, _UINT = 5126, 5123, 5125
 _ARRAY, _ELEMENTS = 34962, 34963
+_REPEAT, _LINEAR_MIPMAP, _LINEAR = 10497, 9987, 9729
+
+
+@dataclass
+class MorphMesh:
+    """A mesh whose vertices move by themselves over an animation's frames.
+
+    mesh : its first frame (a TriMesh; `uv` and `texture` make it textured, the texture repeating outside [0, 1]).
+    frames : (n, V, 3) float32 positions per frame, metres, n = the animation's frames.
+    """
+
+    mesh: TriMesh
+    frames: np.ndarray
 
 
 class _Buffer:
@@ -71,8 +91,8 @@ def _top4(weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return idx.astype(np.uint16), w
 
 
-def animated_glb(body, animation: BodyAnimation) -> bytes:  # noqa: ANN001 - a rigged kitsuke.body.Body
-    """The GLB bytes of `body` skinned and moved by `animation`."""
+def animated_glb(body, animation: BodyAnimation, cloth: MorphMesh | None = None) -> bytes:  # noqa: ANN001 - a rigged Body
+    """The GLB bytes of `body` skinned and moved by `animation`, and `cloth` moving with it (optional)."""
     mesh, rig = body.mesh, body.rig
     buf = _Buffer()
     normals = _vertex_normals(mesh.vertices, mesh.faces)
@@ -115,19 +135,33 @@ def animated_glb(body, animation: BodyAnimation) -> bytes:  # noqa: ANN001 - a r
     samplers.append({"input": times, "output": root, "interpolation": "LINEAR"})
     channels.append({"sampler": len(samplers) - 1, "target": {"node": first_joint, "path": "translation"}})
 
-    doc = {
+    meshes = [{"name": "body", "primitives": [{"attributes": attributes, "indices": indices, "material": 0}]}]
+    materials = [
+        {
+            "name": "skin",
+            "pbrMetallicRoughness": {"baseColorFactor": [0.85, 0.72, 0.62, 1.0], "metallicFactor": 0.0},
+            "doubleSided": False,
+        }
+    ]
+    doc: dict = {}
+    roots = [0, first_joint]
+    if cloth is not None:
+        if cloth.frames.shape[0] != animation.n_frames or cloth.frames.shape[1:] != cloth.mesh.vertices.shape:
+            raise ValueError("the cloth needs one (V, 3) frame per animation frame")
+        roots.append(len(nodes))
+        nodes.append({"name": cloth.mesh.name or "cloth", "mesh": 1})
+        _add_morph_mesh(buf, doc, meshes, materials, cloth)
+        weights = buf.add(np.eye(animation.n_frames, dtype=np.float32).reshape(-1), "SCALAR", _FLOAT)
+        samplers.append({"input": times, "output": weights, "interpolation": "LINEAR"})
+        channels.append({"sampler": len(samplers) - 1, "target": {"node": roots[-1], "path": "weights"}})
+
+    doc |= {
         "asset": {"version": "2.0", "generator": "kitsuke"},
         "scene": 0,
-        "scenes": [{"nodes": [0, first_joint]}],
+        "scenes": [{"nodes": roots}],
         "nodes": nodes,
-        "meshes": [{"name": "body", "primitives": [{"attributes": attributes, "indices": indices, "material": 0}]}],
-        "materials": [
-            {
-                "name": "skin",
-                "pbrMetallicRoughness": {"baseColorFactor": [0.85, 0.72, 0.62, 1.0], "metallicFactor": 0.0},
-                "doubleSided": False,
-            }
-        ],
+        "meshes": meshes,
+        "materials": materials,
         "skins": [
             {
                 "joints": list(range(first_joint, first_joint + len(JOINTS))),
@@ -141,6 +175,54 @@ def animated_glb(body, animation: BodyAnimation) -> bytes:  # noqa: ANN001 - a r
         "accessors": buf.accessors,
     }
     return _glb(doc, bytes(buf.data))
+
+
+def _add_morph_mesh(buf: _Buffer, doc: dict, meshes: list, materials: list, cloth: MorphMesh) -> None:
+    """Append the cloth's mesh (one morph target per frame) and its material (textured if it has one)."""
+    mesh = cloth.mesh
+    base = np.asarray(cloth.frames[0], dtype=np.float64)
+    base_n = _vertex_normals(base, mesh.faces)
+    attributes = {
+        "POSITION": buf.add(base, "VEC3", _FLOAT, target=_ARRAY, bounds=True),
+        "NORMAL": buf.add(base_n, "VEC3", _FLOAT, target=_ARRAY),
+    }
+    material: dict = {
+        "name": mesh.name or "cloth",
+        "pbrMetallicRoughness": {"baseColorFactor": [0.55, 0.6, 0.8, 1.0], "metallicFactor": 0.0},
+        "doubleSided": True,
+    }
+    if mesh.uv is not None:
+        attributes["TEXCOORD_0"] = buf.add(
+            np.column_stack([mesh.uv[:, 0], 1.0 - mesh.uv[:, 1]]), "VEC2", _FLOAT, target=_ARRAY
+        )
+    if mesh.uv is not None and mesh.texture is not None:
+        import io
+
+        from PIL import Image
+
+        png = io.BytesIO()
+        Image.fromarray(np.asarray(mesh.texture, dtype=np.uint8)).save(png, format="PNG")
+        while len(buf.data) % 4:
+            buf.data.append(0)
+        buf.views.append({"buffer": 0, "byteOffset": len(buf.data), "byteLength": len(png.getvalue())})
+        buf.data += png.getvalue()
+        doc["images"] = [{"bufferView": len(buf.views) - 1, "mimeType": "image/png"}]
+        doc["samplers"] = [{"magFilter": _LINEAR, "minFilter": _LINEAR_MIPMAP, "wrapS": _REPEAT, "wrapT": _REPEAT}]
+        doc["textures"] = [{"source": 0, "sampler": 0}]
+        material["pbrMetallicRoughness"] = {"baseColorTexture": {"index": 0}, "metallicFactor": 0.0}
+    targets = []
+    for frame in cloth.frames:
+        f = np.asarray(frame, dtype=np.float64)
+        targets.append(
+            {
+                "POSITION": buf.add(f - base, "VEC3", _FLOAT, target=_ARRAY, bounds=True),
+                "NORMAL": buf.add(_vertex_normals(f, mesh.faces) - base_n, "VEC3", _FLOAT, target=_ARRAY),
+            }
+        )
+    indices = buf.add(mesh.faces.reshape(-1), "SCALAR", _UINT, target=_ELEMENTS)
+    primitive = {"attributes": attributes, "indices": indices, "material": len(materials), "targets": targets}
+    meshes.append({"name": mesh.name or "cloth", "primitives": [primitive], "weights": [0.0] * len(targets)})
+    materials.append(material)
 
 
 def _vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -166,9 +248,14 @@ def _glb(doc: dict, binary: bytes) -> bytes:
     )
 
 
-def write_animated_glb(body, animation: BodyAnimation, path: str | os.PathLike[str]) -> Path:  # noqa: ANN001
+def write_animated_glb(
+    body,  # noqa: ANN001
+    animation: BodyAnimation,
+    path: str | os.PathLike[str],
+    cloth: MorphMesh | None = None,
+) -> Path:
     """Write `animated_glb` to `path` atomically."""
-    data = animated_glb(body, animation)
+    data = animated_glb(body, animation, cloth)
     with atomic_path(path) as tmp:
         tmp.write_bytes(data)
     return Path(path)

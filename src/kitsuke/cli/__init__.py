@@ -28,6 +28,7 @@ GROUPS: dict[str, tuple[str, str]] = {
     "drag": ("drag", "drag a dressed garment along the body, with pins (replays a drags file)"),
     "render": ("render", "render meshes to PNG"),
     "pose": ("pose", "extract poses from video/images/camera/BVH, correct them for a kimono, animate the body"),
+    "kimono": ("kimono", "simulate the kimono on a body moved by poses"),
 }
 
 EPILOG = """\

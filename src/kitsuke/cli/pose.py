@@ -56,6 +56,11 @@ def _add_source_options(
     p.add_argument("source", nargs="?", help="video, image, image folder, .bvh or poses .json file")
     p.add_argument("--camera", type=int, metavar="N", help="read a live camera with this index instead of SOURCE")
     p.add_argument("-o", "--output", required=True, help=output_help)
+    add_frame_options(p)
+
+
+def add_frame_options(p: argparse.ArgumentParser) -> None:
+    """Which frames of a pose source to read, and its temporal filter (`load_poses_from_args` reads them)."""
     g = p.add_argument_group("frames")
     g.add_argument("--stride", type=int, default=1, metavar="K", help="use every K-th frame (video, BVH); default 1")
     g.add_argument("--max-frames", type=int, metavar="N", help="stop after N frames (default: all)")
@@ -139,7 +144,8 @@ def register(parser: argparse.ArgumentParser) -> None:
     p.set_defaults(run=run_animate)
 
 
-def _load(args: argparse.Namespace):  # noqa: ANN202 - PoseSequence, imported lazily
+def load_poses_from_args(args: argparse.Namespace):  # noqa: ANN201 - PoseSequence, imported lazily
+    """The poses named by args.source or args.camera, with the options of `add_frame_options`."""
     from ..errors import InputError
     from ..pose import OneEuroConfig, load_poses
 
@@ -189,7 +195,7 @@ def run_extract(args: argparse.Namespace) -> int:
     from ..pose import write_poses
 
     out = checked_output(args.output, _inputs(args))
-    poses = _load(args)
+    poses = load_poses_from_args(args)
     write_poses(poses, out)
     n_valid = int(poses.valid.sum())
     print(f"wrote {out}: {poses.n_frames} frames ({n_valid} with a person) at {poses.fps:g} fps", file=sys.stderr)
@@ -226,7 +232,7 @@ def run_correct(args: argparse.Namespace) -> int:
     if len({p.resolve() for p in outs}) != len(outs):
         raise InputError("the output files must be different")
     table = read_constraints(args.constraints) if args.constraints else None
-    poses = _load(args)
+    poses = load_poses_from_args(args)
     correction = correct_poses(poses, table)
     measures = correction_measures(correction)
     write_poses(correction.poses, out)
@@ -251,7 +257,7 @@ def run_animate(args: argparse.Namespace) -> int:
     from ..body.gltf_animation import write_animated_glb
 
     out = checked_output(args.output, _inputs(args), suffixes=(".glb",))
-    poses = _load(args)
+    poses = load_poses_from_args(args)
     _warn_if_nobody(poses)
     body = default_body()
     animation = animate(body, poses)

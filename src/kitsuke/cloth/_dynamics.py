@@ -412,6 +412,8 @@ def step(
         if body is not None and body.surface is not None and s == n_sub - 1:
             before = p.copy()
             _collide_surface(model, state, p, body.surface)
+            if held is not None:  # the obi holds them where the skin puts them, whatever lies around
+                p[held.vertices] = before[held.vertices]
             K.finish(x, v, before, inv_mass, h, keep)
             _absorb_push(x, v, p - before)
             continue

@@ -155,12 +155,18 @@ def garment_glb_mesh(
     garment: DressedGarment | GarmentFile, *, tile_m: float = 1.0, texture: np.ndarray | None = None
 ) -> TriMesh:
     """The garment as a TriMesh for viewers: vertices split where corners disagree on uv; uv = pattern / tile_m."""
+    index, faces, uv = viewer_vertices(garment)
+    return TriMesh(garment.positions[index], faces, uv / tile_m, name=garment.name, texture=texture)
+
+
+def viewer_vertices(garment: DressedGarment | GarmentFile) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """How viewers see the garment: (V', ) int64 the garment vertex of each viewer vertex (split where corners
+    disagree on uv: a seam), (F, 3) faces on them, (V', 2) their pattern uv in metres."""
     corner_v = garment.faces.reshape(-1)
     corner_uv = garment.corner_uv.reshape(-1, 2)
     key = np.concatenate([corner_v[:, None].astype(np.float64), np.round(corner_uv, 9)], axis=1)
     uniq, inverse = np.unique(key, axis=0, return_inverse=True)
-    vertices = garment.positions[uniq[:, 0].astype(np.int64)]
-    return TriMesh(vertices, inverse.reshape(-1, 3), uniq[:, 1:] / tile_m, name=garment.name, texture=texture)
+    return uniq[:, 0].astype(np.int64), inverse.reshape(-1, 3), uniq[:, 1:]
 
 
 def write_garment_glb(

@@ -33,6 +33,12 @@ def is_kimono(pattern) -> bool:
     return "kimono" in getattr(pattern, "meta", {})
 
 
+def check_kimono(pattern) -> None:  # noqa: ANN001 - a Pattern
+    """InputError naming the pattern's file unless it is a kimono (`is_kimono`)."""
+    if not is_kimono(pattern):
+        raise InputError("this pattern is not a kimono (made by `kitsuke pattern kimono`: no obi line)", pattern.source)
+
+
 def kimono_params(body, params: WrapParams | None = None, *, hang: float | None = None) -> WrapParams:
     """`params` (default WrapParams()) made right for a kimono: sleeves that hang, the cloth KIMONO_OFFSET_M off
     the body (where `params` keeps ClothParams' default offset) and, on a rigged body, the waist held in the obi
@@ -63,12 +69,21 @@ def dress_default_kimono(body=None, *, params: WrapParams | None = None) -> Dres
     """Wrap `default_kimono()` on the default body with the packaged strokes `kimono_default`, its waist held in
     the obi band and its sleeves hanging. `body` defaults to `default_body()` (the strokes are drawn on it);
     `params` go through `kimono_params` (a band and a hang they set are kept)."""
-    from ..body import default_body
     from ..pattern import default_kimono
+
+    return dress_kimono(default_kimono(), body, params=params)
+
+
+def dress_kimono(pattern, body=None, *, params: WrapParams | None = None) -> DressedGarment:  # noqa: ANN001
+    """Wrap a kimono `pattern` (from `kitsuke.pattern.make_kimono`: its pieces carry the same names at any size) on
+    `body` (default `default_body()`) with the packaged strokes `kimono_default`, as `dress_default_kimono` does.
+    InputError when the pattern is not a kimono."""
+    from ..body import default_body
     from . import load_packaged_strokes
 
+    check_kimono(pattern)
     body = default_body() if body is None else body
     p = params or WrapParams()
     if p.hold_band_m is None:  # obi_band raises for a body without a rig
         p = dataclasses.replace(p, hold_band_m=obi_band(body))
-    return wrap(body, default_kimono(), load_packaged_strokes("kimono_default"), params=kimono_params(body, p))
+    return wrap(body, pattern, load_packaged_strokes("kimono_default"), params=kimono_params(body, p))

@@ -34,6 +34,13 @@ class QualityTargets:
         """The targets for garments and strokes nobody tuned for (benchmarks/bench_corpus.py): max strain 10 %."""
         return cls(max_strain=0.10)
 
+    @classmethod
+    def motion(cls) -> QualityTargets:
+        """The targets of each frame of a simulated garment on a moving body (`kitsuke.tryon`): no vertex more
+        than 5 mm inside (the skin itself moves by linear blend skinning and folds at the joints), max strain
+        10 %."""
+        return cls(penetration_mm=5.0, max_strain=0.10)
+
 
 @dataclass
 class QualityReport:

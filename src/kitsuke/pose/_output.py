@@ -23,6 +23,7 @@ from .._files import atomic_path
 from .._prefetch import prefetch
 from .._progress import progress
 from ..errors import InputError
+from ..render.video import mp4_writer
 from ..skeleton import BONES, INDEX, JOINTS
 from ._constraints import PAIRS
 from ._correct import Correction, regions_of
@@ -291,8 +292,6 @@ def write_overlay_video(
     right. Other sources (BVH, JSON without frames): a front view and a top view with the kimono regions K of the
     corrected pose, on a dark background of `synthetic_size`.
     """
-    import imageio_ffmpeg
-
     from ._mediapipe import _cv2
 
     cv2 = _cv2()
@@ -312,62 +311,47 @@ def write_overlay_video(
         scale, pelvis = _views(poses, *size)
     out_size = (2 * size[0], size[1]) if side_by_side and it is not None else size
     fps = float(poses.fps)
-    params = ["-preset", "veryfast", "-crf", "23", "-movflags", "+faststart", "-f", "mp4"]
     residuals: list[np.ndarray] = []
-    with atomic_path(path) as tmp:
-        writer = imageio_ffmpeg.write_frames(
-            str(tmp),
-            out_size,
-            fps=fps,
-            codec="libx264",
-            quality=None,
-            macro_block_size=2,
-            output_params=params,
-            ffmpeg_log_level="error",
-        )
-        writer.send(None)
-        try:
-            for f in progress(range(poses.n_frames), total=poses.n_frames, desc="video"):
-                highlight: set[int] = set()
-                for p in range(2):
-                    if correction.rotated[f, p]:
-                        tj = int(correction.target[f, p])
-                        highlight |= {tj} | {j for j in range(len(JOINTS)) if _below(j, tj)}
-                if it is None:
-                    img = _synthetic_frame(cv2, poses, f, size, scale, pelvis, correction, highlight)
-                    _legend(cv2, img, LEGEND, (10, 34))
-                else:
-                    frame = next(it, None)
-                    img = np.zeros((size[1], size[0], 3), np.uint8) if frame is None else frame
-                    right = img.copy() if side_by_side else img
-                    sk = image_skeletons(poses, f, s)
-                    if sk is not None:
-                        raw_uv, cor_uv, res = sk
-                        residuals.append(res[np.isfinite(res)])
-                        if side_by_side:
-                            _draw_skeleton(cv2, img, raw_uv, COLOUR, 3)
-                            _draw_skeleton(cv2, right, cor_uv, COLOUR, 3, highlight)
-                        else:
-                            _draw_skeleton(cv2, img, raw_uv, GREY, 7)
-                            _draw_skeleton(cv2, img, cor_uv, COLOUR, 3, highlight)
+    with mp4_writer(path, out_size, fps) as send:
+        for f in progress(range(poses.n_frames), total=poses.n_frames, desc="video"):
+            highlight: set[int] = set()
+            for p in range(2):
+                if correction.rotated[f, p]:
+                    tj = int(correction.target[f, p])
+                    highlight |= {tj} | {j for j in range(len(JOINTS)) if _below(j, tj)}
+            if it is None:
+                img = _synthetic_frame(cv2, poses, f, size, scale, pelvis, correction, highlight)
+                _legend(cv2, img, LEGEND, (10, 34))
+            else:
+                frame = next(it, None)
+                img = np.zeros((size[1], size[0], 3), np.uint8) if frame is None else frame
+                right = img.copy() if side_by_side else img
+                sk = image_skeletons(poses, f, s)
+                if sk is not None:
+                    raw_uv, cor_uv, res = sk
+                    residuals.append(res[np.isfinite(res)])
                     if side_by_side:
-                        for panel, title in ((img, "raw"), (right, "corrected")):
-                            cv2.putText(panel, title, (10, 28), cv2.FONT_HERSHEY_SIMPLEX, 0.8, (255, 255, 255), 2)
-                        _legend(cv2, right, LEGEND_SIDE, (10, 40))
-                        img = np.hstack([img, right])
+                        _draw_skeleton(cv2, img, raw_uv, COLOUR, 3)
+                        _draw_skeleton(cv2, right, cor_uv, COLOUR, 3, highlight)
                     else:
-                        _legend(cv2, img, LEGEND)
-                label = f"t={poses.times[f]:.2f}s"
-                if highlight:
-                    label += "  corrected: " + ", ".join(
-                        JOINTS[t] for t in correction.target[f] if t >= 0 and t in highlight
-                    )
-                cv2.putText(
-                    img, label, (10, out_size[1] - 12), cv2.FONT_HERSHEY_SIMPLEX, 0.6, (255, 255, 255), 2, cv2.LINE_AA
+                        _draw_skeleton(cv2, img, raw_uv, GREY, 7)
+                        _draw_skeleton(cv2, img, cor_uv, COLOUR, 3, highlight)
+                if side_by_side:
+                    for panel, title in ((img, "raw"), (right, "corrected")):
+                        cv2.putText(panel, title, (10, 28), cv2.FONT_HERSHEY_SIMPLEX, 0.8, (255, 255, 255), 2)
+                    _legend(cv2, right, LEGEND_SIDE, (10, 40))
+                    img = np.hstack([img, right])
+                else:
+                    _legend(cv2, img, LEGEND)
+            label = f"t={poses.times[f]:.2f}s"
+            if highlight:
+                label += "  corrected: " + ", ".join(
+                    JOINTS[t] for t in correction.target[f] if t >= 0 and t in highlight
                 )
-                writer.send(np.ascontiguousarray(img[:, :, ::-1]))
-        finally:
-            writer.close()
+            cv2.putText(
+                img, label, (10, out_size[1] - 12), cv2.FONT_HERSHEY_SIMPLEX, 0.6, (255, 255, 255), 2, cv2.LINE_AA
+            )
+            send(img[:, :, ::-1])
     if not residuals:
         return {"fit_residual_px": None}
     r = np.concatenate(residuals)
