@@ -31,6 +31,7 @@ previous frame, keeping bone lengths and the motion's continuity. A JSON summary
 examples:
   kitsuke pose correct clip.mp4 -o corrected.json --plot legs.png --video overlay.mp4
   kitsuke pose correct poses.json -o corrected.json --constraints my_kimono.json
+  kitsuke pose correct poses.json -o corrected.json --constraints calibrated  # the shipped simulated table
   kitsuke pose correct kick.bvh -o kick_corrected.json --video kick.mp4
 """
 
@@ -117,7 +118,8 @@ def register(parser: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--constraints",
         metavar="TABLE.json",
-        help="E/A table (SPEC 3.4 constraints); default: the shipped standard-kimono geometric estimate",
+        help="E/A table (SPEC 3.4 constraints) file, or a shipped one by name: geometric (the default, a "
+        "geometric estimate) or calibrated (by cloth simulation)",
     )
     p.add_argument("--plot", metavar="PNG", help="write a plot of knee/ankle distances, raw and corrected, vs E(θ)")
     p.add_argument(
@@ -182,7 +184,10 @@ def load_poses_from_args(args: argparse.Namespace):  # noqa: ANN201 - PoseSequen
 
 
 def _inputs(args: argparse.Namespace) -> list[str]:
-    return [a for a in (args.source, getattr(args, "constraints", None)) if a]
+    from ..pose._constraints import PACKAGED_CONSTRAINTS
+
+    named = getattr(args, "constraints", None) in PACKAGED_CONSTRAINTS
+    return [a for a in (args.source, None if named else getattr(args, "constraints", None)) if a]
 
 
 def _warn_if_nobody(poses) -> None:  # noqa: ANN001 - PoseSequence, imported lazily
@@ -215,8 +220,8 @@ def run_correct(args: argparse.Namespace) -> int:
     from ..pose import (
         correct_poses,
         correction_measures,
+        load_constraints,
         plot_distances,
-        read_constraints,
         write_overlay_video,
         write_poses,
     )
@@ -231,7 +236,7 @@ def run_correct(args: argparse.Namespace) -> int:
             outs.append(checked_output(extra, inputs))
     if len({p.resolve() for p in outs}) != len(outs):
         raise InputError("the output files must be different")
-    table = read_constraints(args.constraints) if args.constraints else None
+    table = load_constraints(args.constraints) if args.constraints else None
     poses = load_poses_from_args(args)
     correction = correct_poses(poses, table)
     measures = correction_measures(correction)

@@ -10,9 +10,12 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
+
 from ..cloth import ClothParams
 from ..errors import InputError
 from ..skeleton import INDEX
+from .strokes import Strokes
 from .wrap import DressedGarment, WrapParams, wrap
 
 #: Width of a tied obi on the body, metres (a fukuro obi is 31 cm, folded in half lengthwise when tied).
@@ -75,10 +78,12 @@ def dress_default_kimono(body=None, *, params: WrapParams | None = None) -> Dres
 
 
 def dress_kimono(pattern, body=None, *, params: WrapParams | None = None) -> DressedGarment:  # noqa: ANN001
-    """Wrap a kimono `pattern` (from `kitsuke.pattern.make_kimono`: its pieces carry the same names at any size) on
-    `body` (default `default_body()`) with the packaged strokes `kimono_default`, as `dress_default_kimono` does.
+    """Wrap a kimono `pattern` (from `kitsuke.pattern.make_kimono`) on `body` (default `default_body()`), its waist
+    held in the obi band and its sleeves hanging, with the packaged strokes `kimono_default` (drawn on the standard
+    kimono, carried to other sizes by `carried_strokes`).
     InputError when the pattern is not a kimono."""
     from ..body import default_body
+    from ..pattern import default_kimono
     from . import load_packaged_strokes
 
     check_kimono(pattern)
@@ -86,4 +91,22 @@ def dress_kimono(pattern, body=None, *, params: WrapParams | None = None) -> Dre
     p = params or WrapParams()
     if p.hold_band_m is None:  # obi_band raises for a body without a rig
         p = dataclasses.replace(p, hold_band_m=obi_band(body))
-    return wrap(body, pattern, load_packaged_strokes("kimono_default"), params=kimono_params(body, p))
+    strokes = carried_strokes(load_packaged_strokes("kimono_default"), default_kimono(), pattern)
+    return wrap(body, pattern, strokes, params=kimono_params(body, p))
+
+
+def carried_strokes(strokes: Strokes, drawn_on, pattern) -> Strokes:  # noqa: ANN001 - Patterns
+    """`strokes` drawn on the kimono `drawn_on`, carried to the kimono `pattern` of other sizes: each pattern
+    stroke's points scaled from its piece's bounds on the one to the same piece's bounds on the other (the
+    generator makes the same pieces at every size); the body strokes stay."""
+    old = {pc.name: pc.bounds for pc in drawn_on.pieces}
+    new = {pc.name: pc.bounds for pc in pattern.pieces}
+    pairs = []
+    for pair in strokes.pairs:
+        name = pair.pattern.piece
+        if name not in old or name not in new:
+            raise InputError(f"stroke {pair.id}: the kimono has no piece {name!r}", pattern.source)
+        (a0, a1), (b0, b1) = old[name], new[name]
+        points = b0 + (pair.pattern.points - a0) * (b1 - b0) / np.maximum(a1 - a0, 1e-9)
+        pairs.append(dataclasses.replace(pair, pattern=dataclasses.replace(pair.pattern, points=points)))
+    return dataclasses.replace(strokes, pairs=pairs)

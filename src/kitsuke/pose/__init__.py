@@ -7,8 +7,9 @@ Sources (all give a `PoseSequence` in the SPEC §2 joint set, metres, Y up, faci
 - `read_poses` / `write_poses`: the `kitsuke.poses` v1 JSON file.
 Filtering: `filter_poses` (One-Euro, `OneEuroConfig`).
 Correction: `correct_poses(poses, constraints)` → `Correction`; `correction_measures`, `check_invariants`.
-Constraints: `ConstraintTable`, `PairLimit`, `read_constraints`, `write_constraints`, `default_constraints`,
-`geometric_estimate` (the shipped provisional table), `write_default_constraints`.
+Constraints: `ConstraintTable`, `PairLimit`, `read_constraints`, `write_constraints`, `default_constraints` (the
+shipped geometric estimate), `packaged_constraints` / `load_constraints` (shipped tables by name: "geometric",
+"calibrated" by simulation), `geometric_estimate`, `write_default_constraints` (the geometric table's file).
 Outputs: `plot_distances` (PNG), `write_overlay_video` (H.264 mp4).
 
 mediapipe, OpenCV and matplotlib are imported only by the functions that need them.
@@ -22,6 +23,8 @@ from ._constraints import (
     PairLimit,
     default_constraints,
     geometric_estimate,
+    load_constraints,
+    packaged_constraints,
     read_constraints,
     write_constraints,
     write_default_constraints,
@@ -48,6 +51,8 @@ __all__ = [
     "correct_poses",
     "correction_measures",
     "default_constraints",
+    "load_constraints",
+    "packaged_constraints",
     "extract_camera",
     "extract_images",
     "extract_video",

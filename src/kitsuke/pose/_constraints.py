@@ -2,8 +2,9 @@
 
 E_J(θ) is the largest horizontal distance between the two joints of a pair (knees, ankles) that the kimono allows
 when the line between them makes the angle θ with the body's left→right hip axis; A_J is the area of the kimono's
-cross-section near those joints (SPEC §5.2). Until cloth-simulation calibration exists (`kitsuke kimono calibrate`),
-kitsuke ships a *geometric estimate* (`geometric_estimate`, derivation in its docstring).
+cross-section near those joints (SPEC §5.2). kitsuke ships two tables for the standard kimono: the default, a
+*geometric estimate* (`geometric_estimate`, derivation in its docstring), and one calibrated by cloth simulation
+(`kitsuke kimono calibrate`, `kitsuke.tryon.calibrate`), by name "calibrated".
 """
 
 from __future__ import annotations
@@ -23,7 +24,13 @@ from ..errors import InputError
 #: Joint pairs the correction handles, in the order it handles them (SPEC §5.3: knees first, then ankles).
 PAIRS: tuple[str, ...] = ("knee", "ankle")
 
-DEFAULT_CONSTRAINTS_FILE = "kimono_standard_geometric.json"
+#: The tables shipped for the standard kimono, by name: "geometric" (`geometric_estimate`; the default) and
+#: "calibrated" (cloth simulation, `kitsuke kimono calibrate`: not the default yet, see `default_constraints`).
+PACKAGED_CONSTRAINTS = {
+    "geometric": "kimono_standard_geometric.json",
+    "calibrated": "kimono_standard_calibrated.json",
+}
+DEFAULT_CONSTRAINTS_FILE = PACKAGED_CONSTRAINTS["geometric"]
 
 
 @dataclass(frozen=True)
@@ -151,11 +158,26 @@ def write_constraints(table: ConstraintTable, path: str | os.PathLike[str]) -> P
 
 
 def default_constraints() -> ConstraintTable:
-    """The table shipped with kitsuke for the standard-size kimono (a geometric estimate, see
-    `geometric_estimate`)."""
-    ref = resources.files("kitsuke") / "assets" / "constraints" / DEFAULT_CONSTRAINTS_FILE
+    """The table kitsuke corrects with by default: the standard kimono's geometric estimate. The table calibrated
+    by simulation (`packaged_constraints("calibrated")`) is not the default yet: it allows 20-60 % wider spreads
+    and does not yet grow with a wider kimono at every angle (BENCHMARKS.md)."""
+    return packaged_constraints("geometric")
+
+
+def packaged_constraints(name: str) -> ConstraintTable:
+    """A table shipped with kitsuke, by name (`PACKAGED_CONSTRAINTS`: "calibrated" or "geometric")."""
+    if name not in PACKAGED_CONSTRAINTS:
+        raise InputError(f"no shipped constraints table {name!r}; shipped: {', '.join(PACKAGED_CONSTRAINTS)}")
+    ref = resources.files("kitsuke") / "assets" / "constraints" / PACKAGED_CONSTRAINTS[name]
     with resources.as_file(ref) as p:
         return read_constraints(p)
+
+
+def load_constraints(name_or_path: str | os.PathLike[str]) -> ConstraintTable:
+    """A shipped table by name ("calibrated", "geometric") or a table file (`read_constraints`)."""
+    if str(name_or_path) in PACKAGED_CONSTRAINTS:
+        return packaged_constraints(str(name_or_path))
+    return read_constraints(name_or_path)
 
 
 # ------------------------------------------------------------------------------------------ geometric estimate

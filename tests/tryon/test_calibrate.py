@@ -1,0 +1,121 @@
+"""E by simulation: the leg spreads it drives, what counts as the kimono breaking, and a coarse calibration that
+writes a table `pose correct` reads."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from kitsuke.body import default_body
+from kitsuke.body.skinning import forward_kinematics
+from kitsuke.pose import load_constraints, packaged_constraints, read_constraints
+from kitsuke.skeleton import BONES, INDEX
+from kitsuke.tryon.calibrate import (
+    CalibrationSettings,
+    calibrate,
+    cross_section_area,
+    spread_pose,
+    uncovered,
+)
+
+
+@pytest.fixture(scope="module")
+def body():
+    return default_body()
+
+
+def _theta_deg(joints: np.ndarray, left: int, right: int) -> float:
+    """θ as the posture correction measures it (`kitsuke.pose._kernels.region`)."""
+    h = joints[INDEX["r_hip"], ::2] - joints[INDEX["l_hip"], ::2]
+    h /= np.linalg.norm(h)
+    f = np.array([h[1], -h[0]])
+    u = joints[right, ::2] - joints[left, ::2]
+    return math.degrees(math.atan2(u @ f, u @ h)) % 180.0
+
+
+@pytest.mark.parametrize("pair", ["knee", "ankle"])
+@pytest.mark.parametrize("theta", [0.0, 30.0, 90.0, 135.0, 165.0])
+def test_the_legs_spread_along_theta_with_their_own_bones(body, pair, theta):
+    rest = body.rig.joints
+    left, right = INDEX[f"l_{pair}"], INDEX[f"r_{pair}"]
+    rot = spread_pose(rest, pair, theta, 0.35)
+    joints = forward_kinematics(rest, rot, rest[INDEX["pelvis"]])
+    d = joints[right, ::2] - joints[left, ::2]
+    assert np.linalg.norm(d) == pytest.approx(0.35, abs=1e-9)
+    assert _theta_deg(joints, left, right) == pytest.approx(theta % 180.0, abs=1e-6)
+    mid = 0.5 * (joints[left, ::2] + joints[right, ::2])
+    np.testing.assert_allclose(mid, 0.5 * (rest[left, ::2] + rest[right, ::2]), atol=1e-9)
+    x_side = np.array([-1.0, 0.0])  # the body's right is -X: the right joint stays on the right
+    assert (joints[right, ::2] - joints[left, ::2]) @ x_side >= -1e-9
+    for a, b in BONES:
+        ia, ib = INDEX[a], INDEX[b]
+        assert np.linalg.norm(joints[ib] - joints[ia]) == pytest.approx(np.linalg.norm(rest[ib] - rest[ia]))
+    np.testing.assert_allclose(joints[: INDEX["l_hip"]], rest[: INDEX["l_hip"]], atol=1e-12)  # the rest stands
+    half = spread_pose(rest, pair, theta, 0.35, blend=0.0)
+    np.testing.assert_allclose(half, np.tile(np.eye(3), (len(rest), 1, 1)), atol=1e-12)  # blend 0: standing
+
+
+def test_a_leg_shows_where_the_cloth_ring_has_a_gap_over_it():
+    ring_angles = np.radians(np.arange(0.0, 360.0, 4.0))
+    open_front = (np.degrees(ring_angles) < 60) | (np.degrees(ring_angles) > 120)
+    ring = 0.2 * np.column_stack([np.cos(ring_angles), np.sin(ring_angles)])
+    leg_angles = np.radians(np.arange(0.0, 360.0, 10.0))
+    normals = np.column_stack([np.cos(leg_angles), np.sin(leg_angles)])
+    leg = np.array([0.0, 0.12]) + 0.06 * normals  # a leg near the front of the ring
+    assert not uncovered(leg, normals, ring, 0.03).any()
+    shown = uncovered(leg, normals, ring[open_front], 0.03)
+    # where each point's outward ray meets the ring: |p + t n| = 0.2
+    pn = (leg * normals).sum(axis=1)
+    t = -pn + np.sqrt(pn**2 - (leg * leg).sum(axis=1) + 0.04)
+    hit = np.degrees(np.arctan2(*(leg + t[:, None] * normals).T[::-1]))
+    assert shown[(hit > 68) & (hit < 112)].all()  # the gap, less the window's reach at either side
+    assert not shown[(hit < 52) | (hit > 128)].any()
+    assert uncovered(leg, normals, np.zeros((0, 2)), 0.03).all()
+
+
+def test_cross_section_area_of_a_tube():
+    a = np.linspace(0, 2 * np.pi, 200, endpoint=False)
+    tube = np.concatenate([np.column_stack([0.15 * np.cos(a), np.full(200, y), 0.1 * np.sin(a)]) for y in (0.4, 0.5)])
+    assert cross_section_area(tube, 0.5, band_m=0.02) == pytest.approx(math.pi * 0.15 * 0.1, rel=1e-3)
+
+
+def test_shipped_tables_by_name(run_cli, tmp_path):
+    calibrated = packaged_constraints("calibrated")
+    assert calibrated.source == "calibrated" and len(calibrated.knee.theta_deg) == 12
+    assert load_constraints("geometric").source == "geometric estimate"
+    r = run_cli("pose", "correct", "tests/data/pose/cmu_10_01_soccer_kick_mh.bvh", "--stride", "8",
+                "-o", tmp_path / "c.json", "--constraints", "calibrated")  # fmt: skip
+    assert r.code == 0, r.err
+    assert json.loads((tmp_path / "c.json").read_text())["constraints"]["source"] == "calibrated"
+    r = run_cli("pose", "correct", "tests/data/pose/cmu_10_01_soccer_kick_mh.bvh", "-o", tmp_path / "d.json",
+                "--constraints", "nonesuch")  # fmt: skip
+    assert r.code == 2
+
+
+@pytest.mark.slow
+def test_a_coarse_calibration_is_bounded_mirror_symmetric_and_readable(run_cli, tmp_path, body):
+    """Every 45°: each E lies between the standing start and the legs' reach, E(θ) and E(180° − θ) (the same
+    spread with the other leg forward) agree within 25 % (the kimono is symmetric but for its left-over-right
+    fronts), and the CLI writes a table and a plot that `pose correct` reads."""
+    from kitsuke.tryon import default_simulation_kimono
+
+    kimono = default_simulation_kimono(body)
+    settings = CalibrationSettings(theta_step_deg=45.0, bisections=2)
+    result = calibrate(kimono, body, settings=settings)
+    for pair in ("knee", "ankle"):
+        e = result.table.pair(pair).max_distance_m
+        assert np.all(e >= settings.start_m) and np.all(e < settings.max_m)
+        assert abs(e[1] - e[3]) <= 0.25 * 0.5 * (e[1] + e[3]), (pair, e)
+        assert all(r["broke"] in ("torn", "leg outside", "pushed inside") for r in result.spreads[pair])
+    from kitsuke.dressing.export import write_garment_obj
+
+    garment = write_garment_obj(kimono, tmp_path / "kimono.obj")
+    r = run_cli("kimono", "calibrate", "--garment", garment, "--step", "90", "-o", tmp_path / "e.json",
+                "--plot", tmp_path / "e.png")  # fmt: skip
+    assert r.code == 0, r.err
+    table = read_constraints(tmp_path / "e.json")
+    assert table.source == "calibrated" and list(table.knee.theta_deg) == [0.0, 90.0]
+    assert (tmp_path / "e.png").stat().st_size > 20_000
