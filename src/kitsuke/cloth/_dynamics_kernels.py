@@ -102,10 +102,23 @@ def collide_capsules(
     how far each capsule end moved this substep) loses up to `friction` times the push along the surface.
     Returns the number of vertices pushed."""
     pushed = 0
+    n_caps = ends.shape[0]
+    box = np.empty((n_caps, 6))  # each capsule's bounding box with the offset: most vertices are far from most
+    for k in range(n_caps):
+        r = max(radii[k, 0], radii[k, 1]) + offset
+        for c in range(3):
+            box[k, c] = min(ends[k, 0, c], ends[k, 1, c]) - r
+            box[k, 3 + c] = max(ends[k, 0, c], ends[k, 1, c]) + r
     for i in range(p.shape[0]):
         if inv_mass[i] == 0.0:
             continue
-        for k in range(ends.shape[0]):
+        for k in range(n_caps):
+            if (
+                p[i, 0] < box[k, 0] or p[i, 0] > box[k, 3]
+                or p[i, 1] < box[k, 1] or p[i, 1] > box[k, 4]
+                or p[i, 2] < box[k, 2] or p[i, 2] > box[k, 5]
+            ):  # fmt: skip
+                continue
             ax, ay, az = ends[k, 0, 0], ends[k, 0, 1], ends[k, 0, 2]
             ux, uy, uz = ends[k, 1, 0] - ax, ends[k, 1, 1] - ay, ends[k, 1, 2] - az
             uu = ux * ux + uy * uy + uz * uz
