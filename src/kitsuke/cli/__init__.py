@@ -44,6 +44,8 @@ examples:
   kitsuke pose extract clip.mp4 -o poses.json    # MediaPipe, bundled model; also BVH, images, --camera 0
   kitsuke pose correct clip.mp4 -o fixed.json --plot legs.png --video overlay.mp4
   kitsuke pose animate walk.bvh -o walk.glb        # the default body, skinned and animated
+  kitsuke kimono simulate --poses walk.bvh -o walk_kimono.glb --video walk_kimono.mp4   # the kimono moving
+  kitsuke kimono calibrate -o limits.json --plot limits.png                          # E(θ) by simulation
 
 Run `kitsuke <group> --help` for a group's verbs and options.
 

@@ -61,9 +61,11 @@ def solve_distances(
 
 
 @njit(cache=True)
-def limit_strain(p: np.ndarray, inv_mass: np.ndarray, pairs: np.ndarray, rest: np.ndarray, max_strain: float) -> int:
-    """Shorten every pair longer than (1 + max_strain) rest to that length (silk barely stretches); returns how
-    many were shortened."""
+def limit_strain(
+    p: np.ndarray, inv_mass: np.ndarray, pairs: np.ndarray, rest: np.ndarray, max_strain: float, max_squeeze: float
+) -> int:
+    """Bring every pair longer than (1 + max_strain) rest, or shorter than (1 - max_squeeze) rest, to that length
+    (silk barely stretches; cloth squeezed more than its mesh can fold buckles instead); returns how many moved."""
     n = 0
     for k in range(pairs.shape[0]):
         a, b = pairs[k, 0], pairs[k, 1]
@@ -73,10 +75,11 @@ def limit_strain(p: np.ndarray, inv_mass: np.ndarray, pairs: np.ndarray, rest: n
         dx, dy, dz = p[a, 0] - p[b, 0], p[a, 1] - p[b, 1], p[a, 2] - p[b, 2]
         d = math.sqrt(dx * dx + dy * dy + dz * dz)
         top = (1.0 + max_strain) * rest[k]
-        if d <= top:
+        bottom = (1.0 - max_squeeze) * rest[k]
+        if d <= top and (d >= bottom or d < 1e-12):
             continue
         n += 1
-        s = (d - top) / (d * w)
+        s = (d - (top if d > top else bottom)) / (d * w)
         p[a, 0] -= inv_mass[a] * s * dx
         p[a, 1] -= inv_mass[a] * s * dy
         p[a, 2] -= inv_mass[a] * s * dz

@@ -33,16 +33,16 @@ def solve_distances(p, inv_mass, pairs, rest, alpha, alpha_short, lam):
     return p, lam
 
 
-def limit_strain(p, inv_mass, pairs, rest, max_strain):
+def limit_strain(p, inv_mass, pairs, rest, max_strain, max_squeeze):
     p = p.copy()
     for k, (a, b) in enumerate(pairs):
         w = inv_mass[a] + inv_mass[b]
         diff = p[a] - p[b]
         d = np.linalg.norm(diff)
-        top = (1 + max_strain) * rest[k]
-        if w == 0 or d <= top:
+        top, bottom = (1 + max_strain) * rest[k], (1 - max_squeeze) * rest[k]
+        if w == 0 or bottom <= d <= top or d < 1e-12:
             continue
-        corr = (d - top) / w * diff / d
+        corr = (d - (top if d > top else bottom)) / w * diff / d
         p[a] = p[a] - inv_mass[a] * corr
         p[b] = p[b] + inv_mass[b] * corr
     return p
