@@ -9,6 +9,7 @@ import pytest
 from scipy.optimize import brentq
 
 from kitsuke.cloth import (
+    BodyCollider,
     ClothModel,
     ClothState,
     DynamicsParams,
@@ -263,3 +264,18 @@ def test_a_sheet_draped_over_a_bar_rests_on_it():
     assert 0.05 <= state.positions[middle, 1].min() < 0.06
     radial = np.linalg.norm(state.positions[:, :2], axis=1)
     assert radial.min() > 0.05 - 0.001  # nothing inside the bar
+
+
+def test_a_moved_body_has_the_normals_of_a_body_built_there():
+    """`BodyCollider.moved` (compiled, every frame) gives the normals `BodyCollider` computes for a body built at
+    the new pose (numpy)."""
+    from kitsuke.body import default_body
+    from kitsuke.geometry import TriMesh
+
+    body = default_body()
+    collider = BodyCollider.from_body(body)
+    posed = body.pose(rotations={"l_knee": [1.2, 0.0, 0.0], "r_shoulder": [0.0, 0.0, -0.8]})
+    built = BodyCollider.from_mesh(TriMesh(posed.vertices, body.mesh.faces))
+    moved = collider.moved(posed.vertices)
+    for name in ("face_normals", "edge_normals", "vertex_normals"):
+        np.testing.assert_allclose(getattr(moved, name), getattr(built, name), atol=1e-12, rtol=0)

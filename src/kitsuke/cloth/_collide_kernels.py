@@ -620,3 +620,57 @@ def set_parallel(parallel: bool) -> None:
     g = globals()
     for name in ("walk_track", "push_out", "capsule_vertices", "layer_moves"):
         g[name] = njit(parallel=parallel)(g[name].py_func)
+
+
+@njit(cache=True)
+def surface_normals(v, f, adj, face_n, edge_n, vert_n):
+    """A closed surface's normals, into face_n (F, 3), edge_n (F, 3, 3) and vert_n (V, 3) (`BodyCollider`'s: unit
+    face normals, each edge's mean of its two faces' normals, angle-weighted vertex normals); v (V, 3), f (F, 3),
+    adj (F, 3) the face across each edge: `BodyCollider.moved` recomputes them every frame of a simulation. The
+    same arithmetic as `BodyCollider._set_normals` (numpy), summed in the same order; vertex normals agree to
+    2e-16 (numpy's arccos rounds its own way)."""
+    nv = v.shape[0]
+    for t in range(f.shape[0]):
+        a, b, c = f[t, 0], f[t, 1], f[t, 2]
+        e1x, e1y, e1z = v[b, 0] - v[a, 0], v[b, 1] - v[a, 1], v[b, 2] - v[a, 2]
+        e2x, e2y, e2z = v[c, 0] - v[a, 0], v[c, 1] - v[a, 1], v[c, 2] - v[a, 2]
+        nx, ny, nz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x
+        ln = math.sqrt(nx * nx + ny * ny + nz * nz)
+        if ln > 0.0:
+            nx, ny, nz = nx / ln, ny / ln, nz / ln
+        else:
+            nx, ny, nz = 0.0, 0.0, 0.0
+        face_n[t, 0], face_n[t, 1], face_n[t, 2] = nx, ny, nz
+    for i in range(nv):
+        vert_n[i, 0] = 0.0
+        vert_n[i, 1] = 0.0
+        vert_n[i, 2] = 0.0
+    corner = np.empty((nv, 3))
+    for k in range(3):  # each corner's angle weights its face's normal at its vertex
+        corner[:] = 0.0
+        for t in range(f.shape[0]):
+            p, q, r = f[t, k], f[t, (k + 1) % 3], f[t, (k + 2) % 3]
+            ux, uy, uz = v[q, 0] - v[p, 0], v[q, 1] - v[p, 1], v[q, 2] - v[p, 2]
+            wx, wy, wz = v[r, 0] - v[p, 0], v[r, 1] - v[p, 1], v[r, 2] - v[p, 2]
+            lu = math.sqrt(ux * ux + uy * uy + uz * uz)
+            lw = math.sqrt(wx * wx + wy * wy + wz * wz)
+            cosang = ((ux * wx + uz * wz) + uy * wy) / max(lu * lw, 1e-300)  # the order numpy's einsum adds in
+            ang = math.acos(min(1.0, max(-1.0, cosang)))
+            corner[p, 0] += face_n[t, 0] * ang
+            corner[p, 1] += face_n[t, 1] * ang
+            corner[p, 2] += face_n[t, 2] * ang
+        for i in range(nv):
+            vert_n[i, 0] += corner[i, 0]
+            vert_n[i, 1] += corner[i, 1]
+            vert_n[i, 2] += corner[i, 2]
+    for t in range(f.shape[0]):
+        for k in range(3):
+            o = adj[t, k]
+            ex, ey, ez = face_n[t, 0] + face_n[o, 0], face_n[t, 1] + face_n[o, 1], face_n[t, 2] + face_n[o, 2]
+            le = max(math.sqrt(ex * ex + ey * ey + ez * ez), 1e-300)
+            edge_n[t, k, 0], edge_n[t, k, 1], edge_n[t, k, 2] = ex / le, ey / le, ez / le
+    for i in range(nv):
+        ln = max(math.sqrt(vert_n[i, 0] ** 2 + vert_n[i, 1] ** 2 + vert_n[i, 2] ** 2), 1e-300)
+        vert_n[i, 0] /= ln
+        vert_n[i, 1] /= ln
+        vert_n[i, 2] /= ln
