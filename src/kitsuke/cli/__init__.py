@@ -28,6 +28,7 @@ GROUPS: dict[str, tuple[str, str]] = {
     "drag": ("drag", "drag a dressed garment along the body, with pins (replays a drags file)"),
     "render": ("render", "render meshes to PNG"),
     "pose": ("pose", "extract poses from video/images/camera/BVH, correct them for a kimono, animate the body"),
+    "batch": ("batch", "run many dress jobs from a manifest, on this machine's cores or a Ray cluster"),
 }
 
 EPILOG = """\
@@ -43,6 +44,7 @@ examples:
   kitsuke pose extract clip.mp4 -o poses.json    # MediaPipe, bundled model; also BVH, images, --camera 0
   kitsuke pose correct clip.mp4 -o fixed.json --plot legs.png --video overlay.mp4
   kitsuke pose animate walk.bvh -o walk.glb        # the default body, skinned and animated
+  kitsuke batch dress jobs.csv -o out/            # one dress per manifest row, on every core (or --address)
 
 Run `kitsuke <group> --help` for a group's verbs and options.
 
