@@ -71,7 +71,9 @@ class DressKind:
         try:
             if job.strokes is None:
                 params = SuggestParams() if job.min_area is None else SuggestParams(min_area_share=job.min_area)
-                text = strokes_to_json(suggest_strokes(body, pattern, params=params, surface=collider.surface))
+                suggested = suggest_strokes(body, pattern, params=params, surface=collider.surface)
+                suggested.meta["body"] = job.body.path  # as `kitsuke strokes suggest` notes it
+                text = strokes_to_json(suggested)
                 files[STROKES] = text.encode("utf-8")
                 strokes = strokes_from_dict(json.loads(text))
             else:
