@@ -79,7 +79,8 @@ def test_six_jobs_on_two_workers(tmp_path, run_cli, runner_kind, single_process)
     r = run_cli("batch", "dress", m, "-o", out, "--workers", "2", *where)
     # Two jobs gave no garment: exit 1, one line naming the summary.
     assert r.code == 1
-    assert r.err.strip().splitlines()[-1] == f"kitsuke: failed: batch: 2 of 6 jobs gave no garment: see {out}/summary.csv"
+    last = r.err.strip().splitlines()[-1]
+    assert last == f"kitsuke: failed: batch: 2 of 6 jobs gave no garment: see {out}/summary.csv"
     rows = {row["id"]: row for row in json.loads((out / "summary.json").read_text())["jobs"]}
     assert {k: v["status"] for k, v in rows.items()} == {
         "slow": "failed",

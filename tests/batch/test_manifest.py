@@ -30,7 +30,11 @@ def test_csv_rows_become_jobs(tmp_path):
     assert shirt.body == BodySource(str(tmp_path / "bodies" / "mean_all.obj"))
     assert (shirt.pattern, shirt.strokes) == (str(tmp_path / "shirt.json"), str(tmp_path / "s.json"))
     assert (shirt.options, shirt.targets, shirt.timeout_s, shirt.glb, shirt.png) == (
-        DressOptions(), "standard", None, True, False
+        DressOptions(),
+        "standard",
+        None,
+        True,
+        False,
     )
     assert skirt.body == BodySource("default", units="cm")
     assert (skirt.pattern, skirt.strokes, skirt.min_area) == ("/data/skirt.json", None, 0.3)
@@ -43,7 +47,8 @@ def test_json_with_defaults(tmp_path):
     m = tmp_path / "jobs.json"
     m.write_text(json.dumps({
         "defaults": {"body": "default", "strokes": "suggest", "hang": 1},
-        "jobs": [{"id": "a", "pattern": "a.json"}, {"id": "b", "pattern": "b.json", "hang": None, "hold_strokes": True}],
+        "jobs": [{"id": "a", "pattern": "a.json"},
+                 {"id": "b", "pattern": "b.json", "hang": None, "hold_strokes": True}],
     }))  # fmt: skip
     a, b = read_manifest(m)
     assert a.options == DressOptions(hang=1.0) and a.strokes is None

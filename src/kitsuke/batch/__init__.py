@@ -7,8 +7,9 @@
 
 - `manifest`: CSV / JSON manifests -> `Job`s (body, pattern, strokes or "suggest", options).
 - `jobs`: `DressKind`, one dress job in a worker by the same library calls as `kitsuke dress`.
-- `runners`: `LocalRunner` (process pool) and `RayRunner` (Ray, local or a cluster): warm workers, shared inputs
-  read once, per-job time limits, failures kept to their job.
+- `runners`: the scheduler every runner shares: warm workers, shared inputs read once, per-job time limits,
+  failures kept to their job; `workers`: what each worker does; `local`: `LocalRunner`, a process pool on this
+  machine; `on_ray`: `RayRunner`, Ray actors, local or on a cluster.
 - `outdir`: each job's folder written atomically, so `resume` never counts a half-written job.
 - `summary`: summary.csv / summary.json.
 - `outcome`: job statuses, `Outcome`, and `JobKind`, what another kind of batch job provides to run the same way.
@@ -17,10 +18,12 @@ Ray is optional (`pip install 'kitsuke[batch]'`); `LocalRunner` needs nothing mo
 """
 
 from .jobs import DressKind
+from .local import LocalRunner
 from .manifest import BodySource, Job, read_manifest
+from .on_ray import RayRunner, ray_available
 from .outcome import DONE, FAILED, OK, OUT_OF_TARGET, REFUSED, STATUSES, JobKind, Outcome
 from .run import BatchResult, run_batch
-from .runners import LocalRunner, RayRunner, Runner, ray_available
+from .runners import Runner
 
 __all__ = [
     "DONE",

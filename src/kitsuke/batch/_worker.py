@@ -2,7 +2,7 @@
 
 import sys
 
-from kitsuke.batch.runners import local_worker
+from kitsuke.batch.local import local_worker
 
 if __name__ == "__main__":
     local_worker(int(sys.argv[1]))
