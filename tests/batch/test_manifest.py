@@ -22,8 +22,8 @@ def test_csv_rows_become_jobs(tmp_path):
         [
             {"id": "shirt", "body": "bodies/mean_all.obj", "pattern": "shirt.json", "strokes": "s.json"},
             {"id": "skirt", "body": "default", "pattern": "/data/skirt.json", "strokes": "suggest",
-             "edge_length": "2.5", "no_polish": "yes", "min_area": "0.3", "targets": "robust", "timeout": "90",
-             "units": "cm", "png": "true"},
+             "edge_length": "2.5", "no_polish": "yes", "min_area": "0.3", "perturb": "7", "targets": "robust",
+             "timeout": "90", "units": "cm", "png": "true"},
         ],
     )  # fmt: skip
     shirt, skirt = read_manifest(m)
@@ -37,7 +37,7 @@ def test_csv_rows_become_jobs(tmp_path):
         False,
     )
     assert skirt.body == BodySource("default", units="cm")
-    assert (skirt.pattern, skirt.strokes, skirt.min_area) == ("/data/skirt.json", None, 0.3)
+    assert (skirt.pattern, skirt.strokes, skirt.min_area, skirt.perturb) == ("/data/skirt.json", None, 0.3, 7)
     assert skirt.options == DressOptions(edge_length=2.5, no_polish=True)
     assert (skirt.targets, skirt.timeout_s, skirt.png) == ("robust", 90.0, True)
     assert skirt.where == "line 3"
@@ -79,6 +79,7 @@ ROW = {"id": "a", "body": "default", "pattern": "p.json", "strokes": "suggest"}
         ({"timeout": "0"}, "line 2: timeout must be a positive number of seconds"),
         ({"strokes": "s.json", "min_area": "0.2"}, "line 2: min_area is for suggested strokes"),
         ({"targets": "loose"}, "targets must be one of standard, robust"),
+        ({"perturb": "1.5"}, "line 2: perturb must be a seed, an integer >= 0, got '1.5'"),
     ],
 )
 def test_bad_csv_refused_naming_file_and_row(tmp_path, change, message):

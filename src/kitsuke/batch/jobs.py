@@ -1,10 +1,11 @@
 """The dress job: what `kitsuke dress` does for one manifest row, in a worker, by the same library calls.
 
 A job on (body, pattern, strokes or `suggest`) runs `suggest_strokes` where asked (its strokes written as
-`kitsuke strokes suggest` writes them, and read back, so the garment is the one the two commands make), then
-`check_strokes` and `wrap` with `DressOptions.wrap_params`, and writes the outputs `kitsuke dress` writes. Its
-status: ok (every target met), out_of_target (written, the missed targets are its reason), refused (InputError),
-failed (ComputationError: one line naming the stage).
+`kitsuke strokes suggest` writes them, and read back, so the garment is the one the two commands make), perturbs
+them where asked (`perturb_strokes`, seeded: robustness runs), then `check_strokes` and `wrap` with
+`DressOptions.wrap_params`, and writes the outputs `kitsuke dress` writes. Its status: ok (every target met),
+out_of_target (written, the missed targets are its reason), refused (InputError), failed (ComputationError: one
+line naming the stage).
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ from collections.abc import Hashable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from ..errors import ComputationError, InputError
 from .manifest import BodySource, Job
@@ -62,7 +65,14 @@ class DressKind:
 
     def run(self, job: Job, inputs: dict[str, Any], derived: Derived) -> Outcome:
         from ..cloth import BodyCollider
-        from ..dressing import check_strokes, strokes_from_dict, strokes_to_json, suggest_strokes, wrap
+        from ..dressing import (
+            check_strokes,
+            perturb_strokes,
+            strokes_from_dict,
+            strokes_to_json,
+            suggest_strokes,
+            wrap,
+        )
         from ..dressing.suggest import SuggestParams
 
         body, pattern = inputs["body"], inputs["pattern"]
@@ -78,6 +88,9 @@ class DressKind:
                 strokes = strokes_from_dict(json.loads(text))
             else:
                 strokes = inputs["strokes"]
+            if job.perturb is not None:
+                strokes = perturb_strokes(strokes, collider.surface, np.random.default_rng(job.perturb))
+                files[STROKES] = strokes_to_json(strokes).encode("utf-8")
             check_strokes(strokes, pattern)
             garment = wrap(body, pattern, strokes, params=job.options.wrap_params(body, pattern), collider=collider)
         except InputError as e:

@@ -49,6 +49,7 @@ COLUMNS: dict[str, tuple[str, str]] = {
     "hang": ("number", "how strongly cloth off the body turns down (default: 2 for a kimono, else 0)"),
     "no_polish": ("bool", "skip the polish: faster, more strain (default false)"),
     "min_area": ("number", "suggest only: smallest piece given a stroke, share of the largest (default 0.15)"),
+    "perturb": ("integer", "draw the strokes as another hand would (kitsuke.dressing.perturb_strokes), this seed"),
     "units": ("choice", "body file's length unit: " + ", ".join(UNITS) + " (default auto)"),
     "up": ("choice", "body file's up axis: " + ", ".join(AXES) + " (default auto)"),
     "facing": ("choice", "body file's facing axis (default auto)"),
@@ -81,7 +82,8 @@ class Job:
 
     id : its name and output folder. body : where its body comes from. pattern : absolute path. strokes : absolute
     path, or None to suggest them. options : the wrap's options. min_area : suggest's smallest piece share, or
-    None (the default). targets : "standard" (QualityTargets()) or "robust" (QualityTargets.robust()).
+    None (the default). perturb : seed of `perturb_strokes` applied to the strokes (robustness runs), or None.
+    targets : "standard" (QualityTargets()) or "robust" (QualityTargets.robust()).
     timeout_s : seconds it may run, or None (the batch's). glb, png : outputs to write. where : "line 4" / "job 3",
     for messages (not part of what the job is).
     """
@@ -92,6 +94,7 @@ class Job:
     strokes: str | None
     options: DressOptions = DressOptions()
     min_area: float | None = None
+    perturb: int | None = None
     targets: str = "standard"
     timeout_s: float | None = None
     glb: bool = True
@@ -188,6 +191,9 @@ def _job(row: dict[str, Any], folder: Path, where: str) -> Job:
             raise InputError("min_area is for suggested strokes (strokes = suggest)")
         if not 0.0 <= min_area <= 1.0:
             raise InputError(f"min_area must be a share between 0 and 1, got {min_area}")
+    perturb = _number(row, "perturb", None)
+    if perturb is not None and not (perturb >= 0 and perturb == int(perturb)):
+        raise InputError(f"perturb must be a seed, an integer >= 0, got {row['perturb']!r}")
     timeout = _number(row, "timeout", None)
     if timeout is not None and not timeout > 0:
         raise InputError(f"timeout must be a positive number of seconds, got {timeout}")
@@ -205,6 +211,7 @@ def _job(row: dict[str, Any], folder: Path, where: str) -> Job:
         strokes=None if strokes == SUGGEST else _path(folder, strokes),
         options=options,
         min_area=min_area,
+        perturb=None if perturb is None else int(perturb),
         targets=_choice(row, "targets", "standard"),
         timeout_s=timeout,
         glb=_bool(row, "glb", True),

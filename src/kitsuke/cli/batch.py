@@ -8,7 +8,8 @@ import sys
 DRESS_EPILOG = """\
 MANIFEST is CSV or JSON, one job per row. Required columns: id (names the job's output folder), body (a mesh file
 or `default`), pattern, strokes (a strokes file or `suggest`). Optional ones, as `kitsuke dress` options:
-edge_length (cm), stroke_reach (mm), hold_strokes, hang, no_polish; min_area (with suggest); units, up, facing,
+edge_length (cm), stroke_reach (mm), hold_strokes, hang, no_polish; min_area (with suggest); perturb (a seed:
+the strokes drawn as another hand would); units, up, facing,
 group (the body file); targets (standard or robust: what counts as ok); timeout (s, this job); glb (default
 true), png (default false). Relative paths are from the manifest's folder. An empty cell takes the default.
 
