@@ -10,7 +10,7 @@ import pytest
 
 from kitsuke.batch import run_batch
 from kitsuke.batch.outdir import RECORD
-from kitsuke.errors import InputError
+from kitsuke.errors import ComputationError, InputError
 
 from .conftest import make_runner
 from .toy import ToyJob, ToyKind
@@ -93,3 +93,10 @@ def test_resume_runs_only_what_is_missing(tmp_path, runner_kind):
     changed = [*jobs[:4], ToyJob("flaky", "ok")]
     result = run_batch(ToyKind(), changed, out, make_runner(runner_kind, workers=2), resume=True, progress=False)
     assert (result.ran, result.counts["ok"]) == (1, 5)
+
+
+def test_workers_that_cannot_warm_up_stop_the_batch(tmp_path, runner_kind):
+    jobs = [ToyJob("a"), ToyJob("b")]
+    with pytest.raises(ComputationError, match="no worker could start: .*RuntimeError: no kernels here"):
+        run_batch(ToyKind(warm_fails=True), jobs, tmp_path / "out", make_runner(runner_kind, workers=1), progress=False)
+    assert [r["status"] for r in statuses(tmp_path / "out").values()] == ["not_run", "not_run"]

@@ -33,6 +33,7 @@ class ToyJob:
 class ToyKind:
     name: str = "toy"
     loads: list = field(default_factory=list)  # driver side: every input read
+    warm_fails: bool = False
 
     def inputs(self, job: ToyJob) -> dict:
         return {"word": ("word", job.word)}
@@ -47,6 +48,8 @@ class ToyKind:
         return job.timeout_s
 
     def warm(self) -> None:
+        if self.warm_fails:
+            raise RuntimeError("no kernels here")
         _WORKER["warmed"] += 1
 
     def run(self, job: ToyJob, inputs: dict, derived) -> Outcome:

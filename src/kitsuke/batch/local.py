@@ -43,7 +43,7 @@ class LocalRunner(Runner):
         here, there = socket.socketpair()
         log = subprocess.DEVNULL
         if self.log_dir is not None:
-            log = open(os.path.join(os.fspath(self.log_dir), f"worker-{slot.id}.log"), "ab")  # noqa: SIM115
+            log = open(os.path.join(os.fspath(self.log_dir), f"worker-{slot.id}.log"), "ab")
         try:
             process = subprocess.Popen(
                 [sys.executable, "-m", "kitsuke.batch._worker", str(there.fileno())],
@@ -53,14 +53,20 @@ class LocalRunner(Runner):
                 stdin=subprocess.DEVNULL,
                 stdout=log,
                 stderr=log,
+                # Its own session: a Ctrl-C at the terminal stops the driver, which stops its workers; a worker
+                # never dies of it half-way through writing its answer.
+                start_new_session=True,
             )
         finally:
             there.close()
             if log is not subprocess.DEVNULL:
                 log.close()
         conn = Connection(here.detach())
-        conn.send(kind)
         slot.handle = (process, conn)
+        try:
+            conn.send(kind)
+        except OSError:
+            pass  # it died at once: _poll reports it
 
     def _send(self, slot: WorkerSlot, task: Task, inputs: SharedInputs) -> None:
         keys = list((task.keys or {}).values())

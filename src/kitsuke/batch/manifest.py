@@ -37,27 +37,28 @@ AXES = ("auto", "+x", "-x", "+y", "-y", "+z", "-z")
 UNITS = ("auto", "m", "dm", "cm", "mm", "in")
 TARGETS = ("standard", "robust")
 
-#: Every column a manifest may have: name -> (kind, help). Required ones first.
-COLUMNS: dict[str, tuple[str, str]] = {
-    "id": ("text", "the job's name and its output folder OUTDIR/ID (letters, digits, . _ -)"),
-    "body": ("path", "body mesh file (OBJ, GLB, PLY) or `default`"),
-    "pattern": ("path", "pattern file (kitsuke JSON, GarmentCode JSON, SVG)"),
-    "strokes": ("path", "kitsuke strokes JSON, or `suggest` (kitsuke strokes suggest)"),
-    "edge_length": ("number", "garment mesh edge length, cm (default 1.5)"),
-    "stroke_reach": ("number", "how far a stroke may settle from its body stroke, mm (default 8)"),
-    "hold_strokes": ("bool", "hang the garment from its strokes (default false)"),
-    "hang": ("number", "how strongly cloth off the body turns down (default: 2 for a kimono, else 0)"),
-    "no_polish": ("bool", "skip the polish: faster, more strain (default false)"),
-    "min_area": ("number", "suggest only: smallest piece given a stroke, share of the largest (default 0.15)"),
-    "perturb": ("integer", "draw the strokes as another hand would (kitsuke.dressing.perturb_strokes), this seed"),
-    "units": ("choice", "body file's length unit: " + ", ".join(UNITS) + " (default auto)"),
-    "up": ("choice", "body file's up axis: " + ", ".join(AXES) + " (default auto)"),
-    "facing": ("choice", "body file's facing axis (default auto)"),
-    "group": ("text", "keep only this OBJ group of the body file"),
-    "targets": ("choice", "quality targets deciding ok / out_of_target: standard or robust (default standard)"),
-    "timeout": ("number", "seconds this job may take, over --timeout"),
-    "glb": ("bool", "write garment.glb, garment and body (default true)"),
-    "png": ("bool", "write views.png, front/side/back (default false; needs EGL on the workers)"),
+#: Every column a manifest may have: name -> what it holds (`kitsuke batch dress --help` lists them). Required ones
+#: first.
+COLUMNS: dict[str, str] = {
+    "id": "the job's name and its output folder OUTDIR/ID (letters, digits, . _ -)",
+    "body": "body mesh file (OBJ, GLB, PLY) or `default`",
+    "pattern": "pattern file (kitsuke JSON, GarmentCode JSON, SVG)",
+    "strokes": "kitsuke strokes JSON, or `suggest` (kitsuke strokes suggest)",
+    "edge_length": "garment mesh edge length, cm (default 1.5)",
+    "stroke_reach": "how far a stroke may settle from its body stroke, mm (default 8)",
+    "hold_strokes": "hang the garment from its strokes (default false)",
+    "hang": "how strongly cloth off the body turns down (default: 2 for a kimono, else 0)",
+    "no_polish": "skip the polish: faster, more strain (default false)",
+    "min_area": "suggest only: smallest piece given a stroke, share of the largest (default 0.15)",
+    "perturb": "draw the strokes as another hand would (kitsuke.dressing.perturb_strokes), this seed",
+    "units": "body file's length unit: " + ", ".join(UNITS) + " (default auto)",
+    "up": "body file's up axis: " + ", ".join(AXES) + " (default auto)",
+    "facing": "body file's facing axis (default auto)",
+    "group": "keep only this OBJ group of the body file",
+    "targets": "quality targets deciding ok / out_of_target: standard or robust (default standard)",
+    "timeout": "seconds this job may take, over --timeout",
+    "glb": "write garment.glb, garment and body (default true)",
+    "png": "write views.png, front/side/back (default false; needs EGL on the workers)",
 }
 REQUIRED = ("id", "body", "pattern", "strokes")
 CHOICES = {"units": UNITS, "up": AXES, "facing": AXES, "targets": TARGETS}

@@ -95,7 +95,8 @@ class RayRunner(Runner):
             except ray.exceptions.RayActorError as e:
                 news.append((slot, "dead", _first_line(e)))
             except ray.exceptions.RayError as e:
-                news.append((slot, "dead", f"{type(e).__name__}: {_first_line(e)}"))
+                cause = getattr(e, "cause", None) or e  # a RayTaskError carries the worker's own exception
+                news.append((slot, "dead", f"{type(cause).__name__}: {_first_line(cause)}"))
         return news
 
     def _stop(self, slot: WorkerSlot) -> None:

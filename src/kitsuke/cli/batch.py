@@ -6,18 +6,17 @@ import argparse
 import sys
 
 DRESS_EPILOG = """\
-MANIFEST is CSV or JSON, one job per row. Required columns: id (names the job's output folder), body (a mesh file
-or `default`), pattern, strokes (a strokes file or `suggest`). Optional ones, as `kitsuke dress` options:
-edge_length (cm), stroke_reach (mm), hold_strokes, hang, no_polish; min_area (with suggest); perturb (a seed:
-the strokes drawn as another hand would); units, up, facing,
-group (the body file); targets (standard or robust: what counts as ok); timeout (s, this job); glb (default
-true), png (default false). Relative paths are from the manifest's folder. An empty cell takes the default.
+MANIFEST is CSV or JSON, one job per row: id, body, pattern and strokes required, the rest optional (an empty
+cell takes the default). Relative paths are from the manifest's folder. For example:
 
   id,body,pattern,strokes,edge_length
   shirt,mean_all.obj,shirt_mean_specification.json,shirt_mean_all.json,
   skirt,mean_all.obj,corpus/gc_s101_0003_specification.json,suggest,2.5
 
 or in JSON: {"defaults": {"body": "mean_all.obj"}, "jobs": [{"id": "shirt", "pattern": "...", "strokes": "..."}]}
+
+manifest columns:
+{columns}
 
 Each job writes OUTDIR/ID/: garment.obj, report.json, garment.glb (garment and body), strokes.json when suggested,
 views.png when asked, and result.json (its status, reason, measures, time). OUTDIR/summary.csv and summary.json
@@ -50,7 +49,7 @@ def register(parser: argparse.ArgumentParser) -> None:
         "dress",
         help="dress many garments on many bodies (one `kitsuke dress` per manifest row)",
         description="Dress many garments on many bodies: one `kitsuke dress` per manifest row, in parallel.",
-        epilog=DRESS_EPILOG,
+        epilog=DRESS_EPILOG.replace("{columns}", _columns()),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("manifest", metavar="MANIFEST", help="CSV or JSON manifest, one job per row")
@@ -70,6 +69,12 @@ def register(parser: argparse.ArgumentParser) -> None:
     where.add_argument("--address", metavar="ADDR", help="join this Ray cluster (host:port, or `auto`)")
     where.add_argument("--local", action="store_true", help="run in a process pool on this machine, without Ray")
     p.set_defaults(run=run_dress)
+
+
+def _columns() -> str:
+    from ..batch.manifest import COLUMNS
+
+    return "\n".join(f"  {name:13s} {what}" for name, what in COLUMNS.items())
 
 
 def run_dress(args: argparse.Namespace) -> int:
