@@ -40,9 +40,9 @@ def ray_session():
         ray.shutdown()
 
 
-@pytest.fixture(params=["local", "ray"])
+@pytest.fixture(params=["local", pytest.param("ray", marks=pytest.mark.slow)])
 def runner_kind(request):
-    """Each runner in turn: "local" or "ray" (the session's Ray started for it)."""
+    """Each runner in turn: "local" or "ray" (the session's Ray started for it: seconds, so marked slow)."""
     if request.param == "ray":
         request.getfixturevalue("ray_session")
     return request.param

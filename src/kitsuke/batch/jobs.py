@@ -52,15 +52,16 @@ class DressKind:
         return job.timeout_s
 
     def warm(self) -> None:
-        """Load (or, the first time after an install, compile) the wrap's numba kernels: a coarse kimono on the
-        default body goes through every stage (capsules, layers, polish), ~3 s with numba's cache warm."""
+        """Load (or, the first time after an install, compile: ~20 s) the wrap's numba kernels: a kimono at 10 cm
+        edges on the default body goes through every stage (capsules, layers, polish) in ~1-2 s with numba's cache
+        warm (at 6 cm, 3-5 s: the kernels are the same whatever the size)."""
         from ..body import default_body
         from ..dressing import load_packaged_strokes, wrap
         from ..dressing.options import DressOptions
         from ..pattern import default_kimono
 
         body, kimono = default_body(), default_kimono()
-        params = DressOptions(edge_length=6.0).wrap_params(body, kimono)
+        params = DressOptions(edge_length=10.0).wrap_params(body, kimono)
         wrap(body, kimono, load_packaged_strokes("kimono_default"), params=params, check=False)
 
     def run(self, job: Job, inputs: dict[str, Any], derived: Derived) -> Outcome:

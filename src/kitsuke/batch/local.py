@@ -25,7 +25,7 @@ class LocalRunner(Runner):
     the driver's state or its main script is inherited), each talking to the driver over a socket pair.
     log_dir: where each worker's stdout and stderr go (worker-N.log), or None to discard them."""
 
-    name = "local"
+    name = "a process pool on this machine"
 
     def __init__(self, *, log_dir: str | os.PathLike[str] | None = None, **kwargs: Any):
         super().__init__(**kwargs)

@@ -30,7 +30,7 @@ class RayRunner(Runner):
     "auto" finds the local one), or None to start a local Ray for this batch, stopped at its end. In a process
     where Ray is already initialised (a notebook, tests), that Ray is used and left running."""
 
-    name = "ray"
+    name = "Ray"
 
     def __init__(self, *, address: str | None = None, **kwargs: Any):
         super().__init__(**kwargs)
@@ -39,6 +39,11 @@ class RayRunner(Runner):
         self._refs: dict[Any, tuple[WorkerSlot, str, int]] = {}
         self._sent = 0
         self._stored: dict[Hashable, Any] = {}
+
+    def describe(self) -> str:
+        where = f"the cluster at {self.address}" if self.address else "a local Ray"
+        workers = "a worker per CPU" if self.workers is None else f"{self.workers} worker(s)"
+        return f"{where} ({workers})"
 
     def _open(self, kind: JobKind) -> int:
         import logging

@@ -57,6 +57,7 @@ def run_batch(
     todo = [job for job in jobs if job.id not in records]
     runner.use_log_dir(out / LOGS)
     bar = Progress(len(jobs), list(records.values()), enabled=progress)
+    bar.note(f"{len(todo)} jobs to run ({len(records)} finished before) on {runner.describe()}; workers warm up first")
     t0 = time.perf_counter()
 
     def on_outcome(job: Any, outcome: Outcome) -> None:
@@ -95,6 +96,11 @@ class Progress:
             f"done {done} (out of target {t[OUT_OF_TARGET]}), failed {t[FAILED]}, refused {t[REFUSED]}, "
             f"remaining {left}"
         )
+
+    def note(self, text: str) -> None:
+        """A line about the batch (off a terminal only: the bar says enough)."""
+        if self.bar is None and self.lines:
+            print(text, file=sys.stderr, flush=True)
 
     def update(self, record: dict[str, Any]) -> None:
         self.tally[record["status"]] += 1

@@ -5,7 +5,7 @@ receive jobs and report.
 How a batch runs, and why:
 
 - **Workers are warmed once.** Each worker process runs `JobKind.warm` before its first job (numba loads or
-  compiles the wrap's kernels: ~3 s warm, ~20 s the first time after an install), then runs jobs until the end.
+  compiles the wrap's kernels: 1-2 s, ~20 s the first time after an install), then runs jobs until the end.
   A job's time limit starts when the job starts, never during the warm-up.
 - **Each worker holds its next job** (`prefetch`, default 2: one running, one waiting) so that it never waits for
   the driver between jobs: the driver's round trip (receive the outputs, write the job folder, read the next
@@ -125,7 +125,7 @@ class Runner:
     (JobKind.timeout_s overrides it per job), or None. prefetch : jobs each worker holds (1 running + waiting).
     """
 
-    name = "runner"
+    name = "a runner"
 
     def __init__(self, *, workers: int | None = None, timeout_s: float | None = None, prefetch: int = 2):
         if workers is not None and workers < 1:
@@ -135,6 +135,11 @@ class Runner:
         self.workers = workers
         self.timeout_s = timeout_s
         self.prefetch = max(1, prefetch)
+
+    def describe(self) -> str:
+        """What the runner runs on, for a progress line."""
+        workers = "a worker per core" if self.workers is None else f"{self.workers} worker(s)"
+        return f"{self.name} ({workers})"
 
     def use_log_dir(self, path: str | os.PathLike[str]) -> None:
         """Where workers may write their stdout and stderr (OUTDIR/.logs); runners whose workers keep their own
