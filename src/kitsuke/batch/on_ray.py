@@ -31,6 +31,8 @@ class RayRunner(Runner):
     where Ray is already initialised (a notebook, tests), that Ray is used and left running."""
 
     name = "Ray"
+    #: One job at a time: see kitsuke.batch.runners (a result still on its way dies with its worker).
+    prefetch_default = 1
 
     def __init__(self, *, address: str | None = None, **kwargs: Any):
         super().__init__(**kwargs)

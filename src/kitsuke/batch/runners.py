@@ -7,9 +7,12 @@ How a batch runs, and why:
 - **Workers are warmed once.** Each worker process runs `JobKind.warm` before its first job (numba loads or
   compiles the wrap's kernels: 1-2 s, ~20 s the first time after an install), then runs jobs until the end.
   A job's time limit starts when the job starts, never during the warm-up.
-- **Each worker holds its next job** (`prefetch`, default 2: one running, one waiting) so that it never waits for
-  the driver between jobs: the driver's round trip (receive the outputs, write the job folder, read the next
-  pattern, send it) overlaps the next job. Measured overhead: benchmarks/bench_batch.py, BENCHMARKS.md.
+- **A local worker holds its next job** (`prefetch` 2: one running, one waiting), so that it never waits for the
+  driver between jobs: the driver's round trip (receive the outputs, write the job folder, read the next pattern,
+  send it) overlaps the next job. A Ray worker holds one (`prefetch` 1): Ray sends a result back after its task
+  returns, so a worker killed by the job after it (out of memory, a crash) could take that result with it and
+  the wrong job would be blamed; the round trip costs a few milliseconds per job instead. Measured overhead:
+  benchmarks/bench_batch.py, BENCHMARKS.md.
 - **Shared inputs are read once.** The driver reads each body and pattern the first time a job needs it and
   frees it after the last; each worker keeps the inputs it was sent in a small LRU cache, with what it derived
   from them (a body's collider), so a worker receives a body once and builds its collider once. Ray sends them
@@ -122,19 +125,23 @@ class Runner:
     """Runs a JobKind's jobs on workers; subclasses say how workers start, receive jobs and report.
 
     workers : how many (None: the cores of this machine, or of the cluster). timeout_s : a job's time limit
-    (JobKind.timeout_s overrides it per job), or None. prefetch : jobs each worker holds (1 running + waiting).
+    (JobKind.timeout_s overrides it per job), or None. prefetch : jobs each worker holds (1 running + waiting),
+    or None for the runner's default.
     """
 
     name = "a runner"
 
-    def __init__(self, *, workers: int | None = None, timeout_s: float | None = None, prefetch: int = 2):
+    #: Jobs a worker holds unless told otherwise.
+    prefetch_default = 2
+
+    def __init__(self, *, workers: int | None = None, timeout_s: float | None = None, prefetch: int | None = None):
         if workers is not None and workers < 1:
             raise InputError(f"--workers must be at least 1, got {workers}")
         if timeout_s is not None and not timeout_s > 0:
             raise InputError(f"--timeout must be a positive number of seconds, got {timeout_s}")
         self.workers = workers
         self.timeout_s = timeout_s
-        self.prefetch = max(1, prefetch)
+        self.prefetch = max(1, prefetch or self.prefetch_default)
 
     def describe(self) -> str:
         """What the runner runs on, for a progress line."""
