@@ -2,6 +2,7 @@
 as a hand would draw them, dressed on GarmentCode's mean_all body.
 
     python benchmarks/bench_corpus.py --seeds 11 12 --n 12 [--no-perturb] [--drag] [--json out.json]
+    python benchmarks/bench_corpus.py --seeds 101 --batch local --workers 2   # the same jobs through kitsuke.batch
 
 For each seed, `../shared/tools/garment_sampler/sample.py` draws `--n` designs (only those whose outlines do not
 cross); each design's strokes come from `kitsuke.dressing.suggest_strokes` and are then perturbed
@@ -19,6 +20,11 @@ stroke left out). Each is dressed with `wrap` and sorted into:
 It prints a table per design and the shares, the median and worst time, and with `--drag` a 5 cm lift of each
 written garment by a point on its front (`DragSession`), released, once freely and once with its back pinned,
 beside the wrap (within targets: the corpus ones).
+
+With `--batch local` or `--batch ray` the designs are dressed as one `kitsuke batch dress` batch (`--workers`
+workers): each job suggests its strokes and perturbs them with the same seed as here (the manifest's `perturb`
+column), and is sorted the same way from its record and OBJ (garbage: `insane` on the OBJ's positions); it must
+give every design the class the plain run gives. --drag and --set are for the plain run.
 """
 
 from __future__ import annotations
@@ -39,11 +45,19 @@ SAMPLER = ROOT.parent / "shared" / "tools" / "garment_sampler" / "sample.py"
 BODY = ROOT / "tests" / "data" / "bodies" / "mean_all.obj"
 
 
-def sample(seed: int, n: int, out: Path) -> list[Path]:
+def rng_of(path: Path) -> np.random.Generator:
+    """The random generator perturbing a design's strokes: seeded by its name, the same in every run (and in
+    batch_jobs)."""
+    return np.random.default_rng(zlib.crc32(path.stem.encode()))
+
+
+def sample(seed: int, n: int, out: Path, sampler: Path = SAMPLER) -> list[Path]:
     """GarmentCode designs (specification files) drawn by the sampler with `seed`."""
+    if not sampler.exists():
+        sys.exit(f"sampling designs needs GarmentCode's sampler at {sampler} (--sampler)")
     out.mkdir(parents=True, exist_ok=True)
     subprocess.run(
-        [sys.executable, str(SAMPLER), str(out), "--n", str(n), "--seed", str(seed)],
+        [sys.executable, str(sampler), str(out), "--n", str(n), "--seed", str(seed)],
         check=True,
         capture_output=True,
     )
@@ -82,7 +96,7 @@ def dress_one(path: Path, body, collider, surface, rng, perturb: bool, drag: boo
         inverted=r.inverted_count,
         stroke_mm=garment.max_stroke_residual_m * 1e3,
     )
-    bad = insane(garment, surface) + on_body_failures(garment, body, surface=surface)
+    bad = insane(garment.positions, r.strain_max, surface) + on_body_failures(garment, body, surface=surface)
     misses = target_misses(garment, QualityTargets.robust())
     row["status"] = "garbage" if bad else ("ok" if not misses else "out of target")
     row["reason"] = "; ".join(bad or misses)[:200]
@@ -91,19 +105,75 @@ def dress_one(path: Path, body, collider, surface, rng, perturb: bool, drag: boo
     return row
 
 
-def insane(garment, surface) -> list[str]:
-    """A check independent of the wrap's own: a written garment must be finite, within 0.6 m of the body
-    everywhere and nowhere stretched to three times its length."""
-    p = garment.positions
-    if not np.isfinite(p).all():
+def insane(positions, strain_max: float, surface) -> list[str]:
+    """A check independent of the wrap's own: a written garment (positions (V, 3) m, its max edge strain) must be
+    finite, within 0.6 m of the body everywhere and nowhere stretched to three times its length."""
+    if not np.isfinite(positions).all():
         return ["non-finite"]
     out = []
-    far = surface.closest(p).distance.max()
+    far = surface.closest(positions).distance.max()
     if far > 0.6:
         out.append(f"a vertex {far:.2f} m from the body")
-    if garment.report.strain_max > 2.0:
-        out.append(f"strain {100 * garment.report.strain_max:.0f} %")
+    if strain_max > 2.0:
+        out.append(f"strain {100 * strain_max:.0f} %")
     return out
+
+
+#: kitsuke.batch statuses -> this benchmark's classes.
+BATCH_STATUS = {"ok": "ok", "out_of_target": "out of target", "refused": "refused", "failed": "failed"}
+
+
+def batch_jobs(paths: list[Path], perturb: bool) -> list:
+    """kitsuke.batch dress jobs of the designs: suggested strokes, perturbed with rng_of's seed, robust targets."""
+    from kitsuke.batch import BodySource, Job
+
+    return [
+        Job(
+            id=path.stem.replace("_specification", ""),
+            body=BodySource(str(BODY)),
+            pattern=str(path),
+            strokes=None,
+            perturb=zlib.crc32(path.stem.encode()) if perturb else None,
+            targets="robust",
+            glb=False,
+        )
+        for path in paths
+    ]
+
+
+def dress_batch(paths: list[Path], surface, perturb: bool, runner: str, workers: int | None) -> list[dict]:
+    """The designs dressed as one batch (kitsuke.batch, `runner` "local" or "ray"), as rows like dress_one's."""
+    from kitsuke.batch import DressKind, LocalRunner, RayRunner, run_batch
+    from kitsuke.dressing import read_strokes
+    from kitsuke.dressing.export import read_garment_obj
+
+    jobs = batch_jobs(paths, perturb)
+    make = LocalRunner if runner == "local" else RayRunner
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "batch"
+        run_batch(DressKind(), jobs, out, make(workers=workers, timeout_s=600), progress=False)
+        for job in jobs:
+            record = json.loads((out / job.id / "result.json").read_text())
+            m = record["measures"]
+            row = {"design": job.id, "status": BATCH_STATUS[record["status"]], "seconds": record["seconds"]}
+            row["reason"] = record["reason"] if record["status"] != "refused" else record["reason"].split(": ", 1)[-1]
+            if (out / job.id / "strokes.json").exists():
+                row["strokes"] = len(read_strokes(out / job.id / "strokes.json"))
+            if "strain_max_pct" in m:
+                row.update(
+                    strain_mean=m["strain_mean_pct"] / 100,
+                    strain_max=m["strain_max_pct"] / 100,
+                    deepest_mm=m["deepest_mm"],
+                    seam_gap_mm=m["seam_gap_mm"],
+                    inverted=m["inverted"],
+                    stroke_mm=m["stroke_mm"],
+                )
+                bad = insane(read_garment_obj(out / job.id / "garment.obj").positions, row["strain_max"], surface)
+                if bad:
+                    row.update(status="garbage", reason="; ".join(bad))
+            rows.append(row)
+    return rows
 
 
 def drag_lift(garment, body) -> dict:
@@ -146,9 +216,12 @@ def main() -> None:
     ap.add_argument("--keep", help="keep the sampled designs in this folder (reused when already there)")
     ap.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE", help="WrapParams to change (Python values)")
     ap.add_argument("--only", nargs="*", default=None, help="dress only designs whose name contains one of these")
+    ap.add_argument("--sampler", type=Path, default=SAMPLER, help="GarmentCode's sampler (default: %(default)s)")
+    ap.add_argument("--batch", choices=["local", "ray"], help="dress them as one kitsuke.batch batch on this runner")
+    ap.add_argument("--workers", type=int, default=None, help="--batch: workers (default: one per core)")
     args = ap.parse_args()
-    if not SAMPLER.exists():
-        sys.exit(f"bench_corpus needs GarmentCode's sampler at {SAMPLER}")
+    if args.batch and (args.drag or args.set):
+        sys.exit("--drag and --set are for the plain run, not --batch")
 
     import ast
 
@@ -167,12 +240,16 @@ def main() -> None:
         base = Path(args.keep) if args.keep else Path(tmp)
         for seed in args.seeds:
             folder = base / f"seed{seed}"
-            paths = sorted(folder.glob("*_specification.json")) or sample(seed, args.n, folder)
-            for path in paths:
-                if args.only and not any(o in path.stem for o in args.only):
-                    continue
-                rng = np.random.default_rng(zlib.crc32(path.stem.encode()))
-                row = dress_one(path, body, collider, surface, rng, not args.no_perturb, args.drag, params)
+            paths = sorted(folder.glob("*_specification.json")) or sample(seed, args.n, folder, args.sampler)
+            paths = [p for p in paths if not args.only or any(o in p.stem for o in args.only)]
+            if args.batch:
+                done = dress_batch(paths, surface, not args.no_perturb, args.batch, args.workers)
+            else:
+                done = (
+                    dress_one(p, body, collider, surface, rng_of(p), not args.no_perturb, args.drag, params)
+                    for p in paths
+                )
+            for row in done:
                 row["seed"] = seed
                 rows.append(row)
                 print(

@@ -29,6 +29,7 @@ GROUPS: dict[str, tuple[str, str]] = {
     "render": ("render", "render meshes to PNG"),
     "pose": ("pose", "extract poses from video/images/camera/BVH, correct them for a kimono, animate the body"),
     "kimono": ("kimono", "simulate the kimono on a body moved by poses"),
+    "batch": ("batch", "run many dress jobs from a manifest, on this machine's cores or a Ray cluster"),
 }
 
 EPILOG = """\
@@ -46,6 +47,7 @@ examples:
   kitsuke pose animate walk.bvh -o walk.glb        # the default body, skinned and animated
   kitsuke kimono simulate --poses walk.bvh -o walk_kimono.glb --video walk_kimono.mp4   # the kimono moving
   kitsuke kimono calibrate -o limits.json --plot limits.png                          # E(θ) by simulation
+  kitsuke batch dress jobs.csv -o out/            # one dress per manifest row, on every core (or --address)
 
 Run `kitsuke <group> --help` for a group's verbs and options.
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import sys
 
 from ._common import add_body_options, body_from_args, checked_output
@@ -116,8 +115,9 @@ def register(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..cloth import precompile_in_background
     from ..dressing import check_strokes, read_strokes, target_misses
-    from ..dressing.kimono import is_kimono, kimono_params
-    from ..dressing.wrap import DressedGarment, WrapParams, wrap
+    from ..dressing.export import write_garment_outputs
+    from ..dressing.options import DressOptions
+    from ..dressing.wrap import DressedGarment, wrap
     from ..errors import ComputationError, InputError
     from ..pattern import load_pattern
 
@@ -130,12 +130,14 @@ def run(args: argparse.Namespace) -> int:
     outs = [o for o in (glb, obj, report, png) if o is not None]
     if len({o.resolve() for o in outs}) != len(outs):
         raise InputError("the output files must be different")
-    if not 0.2 <= args.edge_length <= 10:
-        raise InputError(f"--edge-length must be between 0.2 and 10 cm, got {args.edge_length}")
-    if not 0 <= args.stroke_reach <= 100:
-        raise InputError(f"--stroke-reach must be between 0 and 100 mm, got {args.stroke_reach}")
-    if args.hang is not None and not 0 <= args.hang <= 10:
-        raise InputError(f"--hang must be between 0 and 10, got {args.hang}")
+    options = DressOptions(
+        edge_length=args.edge_length,
+        stroke_reach=args.stroke_reach,
+        hold_strokes=args.hold_strokes,
+        hang=args.hang,
+        no_polish=args.no_polish,
+    )
+    options.check(spell=lambda name: "--" + name.replace("_", "-"))
     if args.garment:
         if args.stroke_reach != 8.0:
             raise InputError("--stroke-reach is for a wrap: a re-wrap (--garment) holds its strokes already")
@@ -154,22 +156,15 @@ def run(args: argparse.Namespace) -> int:
         # The first run after an install: compile the polish (and a kimono's layer order) on the other core.
         precompile_in_background(layers=bool(pattern.meta.get("layers")))
     body = body_from_args(args)
-    make = WrapParams.strokes_held if args.hold_strokes else WrapParams
-    reach = args.stroke_reach * 1e-3 if args.stroke_reach > 0 else None
-    params = make(edge_length_cm=args.edge_length, stroke_reach_m=reach, hang=args.hang or 0.0)
-    if args.no_polish:
-        params = dataclasses.replace(params, polish_rounds=0)
-    if is_kimono(pattern):
-        params = kimono_params(body, params, hang=args.hang)
     try:
-        garment = wrap(body, pattern, strokes, params=params)
+        garment = wrap(body, pattern, strokes, params=options.wrap_params(body, pattern))
     except ComputationError as e:
         if args.keep_failed and isinstance(e.result, DressedGarment):
             failed = [None if o is None else o.with_suffix(".failed" + o.suffix) for o in (glb, obj, report, png)]
-            _write(e.result, body, *failed)
+            write_garment_outputs(e.result, body.mesh, *failed)
             print(f"kept the failed result as {failed[0]} for inspection", file=sys.stderr)
         raise
-    _write(garment, body, glb, obj, report, png)
+    write_garment_outputs(garment, body.mesh, glb, obj, report, png)
     misses = target_misses(garment)
     verdict = "all quality targets met" if not misses else "targets missed: " + "; ".join(misses)
     print(
@@ -177,19 +172,6 @@ def run(args: argparse.Namespace) -> int:
         file=sys.stderr,
     )
     return 0
-
-
-def _write(garment, body, glb, obj=None, report=None, png=None) -> None:
-    """The dressed garment's outputs (GLB always; OBJ, report, PNG where a path is given)."""
-    from ..dressing.export import write_garment_glb, write_garment_obj, write_garment_png, write_garment_report
-
-    write_garment_glb(garment, glb, body=body.mesh)
-    if obj:
-        write_garment_obj(garment, obj)
-    if report:
-        write_garment_report(garment, report)
-    if png:
-        write_garment_png(garment, body.mesh, png)
 
 
 def _pin_points(values: list[str]) -> list[list[float]]:

@@ -189,6 +189,26 @@ def write_garment_report(garment: DressedGarment, path: str | os.PathLike[str]) 
     return write_json_atomic(path, garment.summary())
 
 
+def write_garment_outputs(
+    garment: DressedGarment,
+    body: TriMesh,
+    glb: str | os.PathLike[str] | None = None,
+    obj: str | os.PathLike[str] | None = None,
+    report: str | os.PathLike[str] | None = None,
+    png: str | os.PathLike[str] | None = None,
+) -> None:
+    """A dressed garment's outputs where a path is given: the GLB with the body, the OBJ, the report, the PNG
+    (what `kitsuke dress` writes, and `kitsuke batch dress` for each job)."""
+    if glb:
+        write_garment_glb(garment, glb, body=body)
+    if obj:
+        write_garment_obj(garment, obj)
+    if report:
+        write_garment_report(garment, report)
+    if png:
+        write_garment_png(garment, body, png)
+
+
 def write_garment_png(
     garment: DressedGarment | GarmentFile,
     body: TriMesh,

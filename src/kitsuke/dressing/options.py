@@ -1,0 +1,53 @@
+"""The options of a dress, as a user gives them (`kitsuke dress` flags, a batch manifest's columns), and the
+WrapParams they stand for. One place, so that a garment dressed by `kitsuke dress` and by `kitsuke batch dress`
+with the same options is the same garment."""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from ..errors import InputError
+from .wrap import WrapParams
+
+
+@dataclass(frozen=True)
+class DressOptions:
+    """What a user chooses about a wrap (see `kitsuke dress --help` for each one's why).
+
+    edge_length : target triangle edge length of the garment mesh, cm (0.2-10).
+    stroke_reach : how far a pattern stroke may settle from its body stroke, mm (0-100; 0: settle freely).
+    hold_strokes : keep the garment hanging from its strokes instead of letting it settle.
+    hang : how strongly cloth growing off the body turns down (0-10), or None: 2 for a kimono, 0 otherwise.
+    no_polish : skip the polish (faster; the max strain stays where the settle left it).
+    """
+
+    edge_length: float = 1.5
+    stroke_reach: float = 8.0
+    hold_strokes: bool = False
+    hang: float | None = None
+    no_polish: bool = False
+
+    def check(self, spell: Callable[[str], str] = lambda name: name) -> None:
+        """Raise InputError for a value out of its range; `spell` turns a field name into what the user wrote
+        (`--edge-length` on the command line, `edge_length` in a manifest)."""
+        if not 0.2 <= self.edge_length <= 10:
+            raise InputError(f"{spell('edge_length')} must be between 0.2 and 10 cm, got {self.edge_length}")
+        if not 0 <= self.stroke_reach <= 100:
+            raise InputError(f"{spell('stroke_reach')} must be between 0 and 100 mm, got {self.stroke_reach}")
+        if self.hang is not None and not 0 <= self.hang <= 10:
+            raise InputError(f"{spell('hang')} must be between 0 and 10, got {self.hang}")
+
+    def wrap_params(self, body, pattern) -> WrapParams:
+        """The WrapParams of these options for `pattern` on `body` (a kimono gets its hang, offset and obi band)."""
+        from .kimono import is_kimono, kimono_params
+
+        make = WrapParams.strokes_held if self.hold_strokes else WrapParams
+        reach = self.stroke_reach * 1e-3 if self.stroke_reach > 0 else None
+        params = make(edge_length_cm=self.edge_length, stroke_reach_m=reach, hang=self.hang or 0.0)
+        if self.no_polish:
+            params = dataclasses.replace(params, polish_rounds=0)
+        if is_kimono(pattern):
+            params = kimono_params(body, params, hang=self.hang)
+        return params
