@@ -1,4 +1,5 @@
-"""Batches: many dress jobs from a manifest, on this machine's cores or a Ray cluster (`kitsuke batch dress`).
+"""Batches: many dress jobs, or kimono calibrations, from a manifest, on this machine's cores or a Ray cluster
+(`kitsuke batch dress`, `kitsuke batch calibrate`).
 
     from kitsuke.batch import DressKind, LocalRunner, RayRunner, read_manifest, run_batch
     jobs = read_manifest("jobs.csv")                         # InputError naming the file and row if it is not one
@@ -6,7 +7,8 @@
     result.counts                                            # {"ok": 4, "out_of_target": 1, "refused": 1, ...}
 
 - `manifest`: CSV / JSON manifests -> `Job`s (body, pattern, strokes or "suggest", options).
-- `jobs`: `DressKind`, one dress job in a worker by the same library calls as `kitsuke dress`.
+- `jobs`: `DressKind`, one dress job in a worker by the same library calls as `kitsuke dress`;
+  `calibrate_jobs`: `CalibrateKind`, one kimono calibration as `kitsuke kimono calibrate` (`read_calibrate_manifest`).
 - `runners`: the scheduler every runner shares: warm workers, shared inputs read once, per-job time limits,
   failures kept to their job; `workers`: what each worker does; `local`: `LocalRunner`, a process pool on this
   machine; `on_ray`: `RayRunner`, Ray actors, local or on a cluster.
@@ -17,9 +19,10 @@
 Ray is optional (`pip install 'kitsuke[batch]'`); `LocalRunner` needs nothing more.
 """
 
+from .calibrate_jobs import CalibrateKind
 from .jobs import DressKind
 from .local import LocalRunner
-from .manifest import BodySource, Job, read_manifest
+from .manifest import BodySource, CalibrateJob, Job, read_calibrate_manifest, read_manifest
 from .on_ray import RayRunner, ray_available
 from .outcome import DONE, FAILED, OK, OUT_OF_TARGET, REFUSED, STATUSES, JobKind, Outcome
 from .run import BatchResult, run_batch
@@ -34,6 +37,8 @@ __all__ = [
     "STATUSES",
     "BatchResult",
     "BodySource",
+    "CalibrateJob",
+    "CalibrateKind",
     "DressKind",
     "Job",
     "JobKind",
@@ -42,6 +47,7 @@ __all__ = [
     "RayRunner",
     "Runner",
     "ray_available",
+    "read_calibrate_manifest",
     "read_manifest",
     "run_batch",
 ]

@@ -1,4 +1,5 @@
-"""A batch manifest: one dress job per row, as CSV or JSON (`kitsuke batch dress --help` shows both).
+"""A batch manifest: one job per row, as CSV or JSON (`kitsuke batch dress --help` shows both): dress jobs
+(`read_manifest`) or kimono calibration jobs (`read_calibrate_manifest`: id, pattern, step, timeout).
 
 CSV: a header row naming the columns, then one job per line; an empty cell takes the default.
 
@@ -61,6 +62,13 @@ COLUMNS: dict[str, str] = {
     "png": "write views.png, front/side/back (default false; needs EGL on the workers)",
 }
 REQUIRED = ("id", "body", "pattern", "strokes")
+#: The columns of a calibration manifest (`kitsuke batch calibrate`).
+CALIBRATE_COLUMNS: dict[str, str] = {
+    "id": COLUMNS["id"],
+    "pattern": "a kimono pattern (kitsuke pattern kimono, JSON), or `default` (the default kimono)",
+    "step": "angle step of E(θ), degrees, dividing 180 (default 15)",
+    "timeout": COLUMNS["timeout"],
+}
 CHOICES = {"units": UNITS, "up": AXES, "facing": AXES, "targets": TARGETS}
 TRUE, FALSE = ("true", "yes", "1"), ("false", "no", "0")
 
@@ -109,16 +117,42 @@ class Job:
         return d
 
 
+@dataclass(frozen=True)
+class CalibrateJob:
+    """One kimono calibration job (`kitsuke kimono calibrate` on the default body). pattern : absolute path of a
+    kimono pattern, or "default". step_deg : the angle step. timeout_s, where : as `Job`'s."""
+
+    id: str
+    pattern: str
+    step_deg: float = 15.0
+    timeout_s: float | None = None
+    where: str = field(default="", compare=False)
+
+    def spec(self) -> dict[str, Any]:
+        d = dataclasses.asdict(self)
+        del d["where"]
+        return d
+
+
 def read_manifest(path: str | Path) -> list[Job]:
-    """The jobs of a CSV (`.csv`) or JSON manifest, in order; InputError naming the file and row otherwise."""
+    """The dress jobs of a CSV (`.csv`) or JSON manifest, in order; InputError naming the file and row otherwise."""
+    return _read(path, COLUMNS, _job)
+
+
+def read_calibrate_manifest(path: str | Path) -> list[CalibrateJob]:
+    """The calibration jobs of a CSV or JSON manifest (`CALIBRATE_COLUMNS`), as `read_manifest` reads dress jobs."""
+    return _read(path, CALIBRATE_COLUMNS, _calibrate_job)
+
+
+def _read(path: str | Path, columns: dict[str, str], make) -> list:  # noqa: ANN001
     p = require_file(path, what="manifest")
-    rows = _csv_rows(p) if p.suffix.lower() == ".csv" else _json_rows(p)
+    rows = _csv_rows(p, columns) if p.suffix.lower() == ".csv" else _json_rows(p, columns)
     if not rows:
         raise InputError("the manifest lists no jobs", p)
     jobs, seen = [], {}
     for where, row in rows:
         try:
-            job = _job(row, p.parent, where)
+            job = make(row, p.parent, where)
         except InputError as e:
             raise InputError(f"{where}: {e.message}", p) from None
         if job.id in seen:
@@ -128,7 +162,7 @@ def read_manifest(path: str | Path) -> list[Job]:
     return jobs
 
 
-def _csv_rows(path: Path) -> list[tuple[str, dict[str, str]]]:
+def _csv_rows(path: Path, columns: dict[str, str]) -> list[tuple[str, dict[str, str]]]:
     try:
         text = path.read_text(encoding="utf-8-sig")  # -sig: spreadsheets write a byte-order mark
     except UnicodeDecodeError:
@@ -136,8 +170,8 @@ def _csv_rows(path: Path) -> list[tuple[str, dict[str, str]]]:
     reader = csv.reader(text.splitlines())
     header = [h.strip() for h in next(reader, [])]
     for h in header:
-        if h not in COLUMNS:
-            raise InputError(f"line 1: unknown column {h!r} (known: {', '.join(COLUMNS)})", path)
+        if h not in columns:
+            raise InputError(f"line 1: unknown column {h!r} (known: {', '.join(columns)})", path)
     rows = []
     for cells in reader:
         where = f"line {reader.line_num}"
@@ -149,7 +183,7 @@ def _csv_rows(path: Path) -> list[tuple[str, dict[str, str]]]:
     return rows
 
 
-def _json_rows(path: Path) -> list[tuple[str, dict[str, Any]]]:
+def _json_rows(path: Path, columns: dict[str, str]) -> list[tuple[str, dict[str, Any]]]:
     data = read_json(path, what="manifest")
     defaults: dict[str, Any] = {}
     if isinstance(data, dict):
@@ -164,19 +198,47 @@ def _json_rows(path: Path) -> list[tuple[str, dict[str, Any]]]:
             raise InputError(f"job {k}: expected an object of column values, got {type(row).__name__}", path)
         merged = {**defaults, **row}
         for name in merged:
-            if name not in COLUMNS:
-                raise InputError(f"job {k}: unknown key {name!r} (known: {', '.join(COLUMNS)})", path)
+            if name not in columns:
+                raise InputError(f"job {k}: unknown key {name!r} (known: {', '.join(columns)})", path)
         rows.append((f"job {k}", {n: v for n, v in merged.items() if v is not None and v != ""}))
     return rows
 
 
-def _job(row: dict[str, Any], folder: Path, where: str) -> Job:
-    for name in REQUIRED:
+def _job_id(row: dict[str, Any], required: tuple[str, ...]) -> str:
+    for name in required:
         if name not in row:
             raise InputError(f"no {name!r}")
     job_id = _text(row, "id")
     if not ID_PATTERN.fullmatch(job_id):
         raise InputError(f"id {job_id!r} cannot name a folder: use letters, digits, . _ - (not starting with .)")
+    return job_id
+
+
+def _timeout(row: dict[str, Any]) -> float | None:
+    timeout = _number(row, "timeout", None)
+    if timeout is not None and not timeout > 0:
+        raise InputError(f"timeout must be a positive number of seconds, got {timeout}")
+    return timeout
+
+
+def _calibrate_job(row: dict[str, Any], folder: Path, where: str) -> CalibrateJob:
+    job_id = _job_id(row, ("id", "pattern"))
+    step = _number(row, "step", 15.0)
+    n = 180.0 / step if step > 0 else math.inf
+    if not (math.isfinite(n) and abs(n - round(n)) < 1e-9):
+        raise InputError(f"step must divide 180 degrees, got {step:g}")
+    pattern = _text(row, "pattern")
+    return CalibrateJob(
+        id=job_id,
+        pattern=pattern if pattern == "default" else _path(folder, pattern),
+        step_deg=step,
+        timeout_s=_timeout(row),
+        where=where,
+    )
+
+
+def _job(row: dict[str, Any], folder: Path, where: str) -> Job:
+    job_id = _job_id(row, REQUIRED)
     strokes = _text(row, "strokes")
     options = DressOptions(
         edge_length=_number(row, "edge_length", 1.5),
@@ -195,9 +257,7 @@ def _job(row: dict[str, Any], folder: Path, where: str) -> Job:
     perturb = _number(row, "perturb", None)
     if perturb is not None and not (perturb >= 0 and perturb == int(perturb)):
         raise InputError(f"perturb must be a seed, an integer >= 0, got {row['perturb']!r}")
-    timeout = _number(row, "timeout", None)
-    if timeout is not None and not timeout > 0:
-        raise InputError(f"timeout must be a positive number of seconds, got {timeout}")
+    timeout = _timeout(row)
     body = _text(row, "body")
     return Job(
         id=job_id,

@@ -1,4 +1,5 @@
-"""`kitsuke batch dress`: many dress jobs from a manifest, on this machine's cores or a Ray cluster."""
+"""`kitsuke batch dress|calibrate`: many dress jobs, or kimono calibrations, from a manifest, on this machine's
+cores or a Ray cluster."""
 
 from __future__ import annotations
 
@@ -43,6 +44,29 @@ examples:
 """
 
 
+CALIBRATE_EPILOG = """\
+MANIFEST is CSV or JSON, one kimono per row (id and pattern required), as for `kitsuke batch dress`:
+
+  id,pattern,step
+  standard,default,15
+  wide,wide_kimono.json,15
+
+manifest columns:
+{columns}
+
+Each job runs `kitsuke kimono calibrate` on the default body: the kimono dressed for simulation, then its limits
+E(θ) for the knees and the ankles by simulated leg spreads, one after another (about 2-4 minutes a kimono on one
+core; the batch's workers run kimonos side by side). It writes OUTDIR/ID/constraints.json (what `kitsuke pose
+correct --constraints` reads) and e.png (E against the geometric estimate), and result.json. The summary lists each
+kimono's smallest and largest E (cm) and cross-section area A (cm²) for knees and ankles. Time limit, resume,
+failure isolation and Ray (--address, --local) as for `kitsuke batch dress`.
+
+examples:
+  kitsuke batch calibrate kimonos.csv -o limits/ --local --workers 2
+  kitsuke batch calibrate kimonos.csv -o limits/ --address 10.0.0.5:6379
+"""
+
+
 def register(parser: argparse.ArgumentParser) -> None:
     verbs = parser.add_subparsers(dest="verb", metavar="<verb>")
     p = verbs.add_parser(
@@ -52,6 +76,20 @@ def register(parser: argparse.ArgumentParser) -> None:
         epilog=DRESS_EPILOG.replace("{columns}", _columns()),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    _add_batch_options(p)
+    p.set_defaults(run=run_dress)
+    p = verbs.add_parser(
+        "calibrate",
+        help="calibrate many kimonos' posture limits E (one `kitsuke kimono calibrate` per manifest row)",
+        description="Calibrate the posture limits E of many kimonos: one `kitsuke kimono calibrate` per row.",
+        epilog=CALIBRATE_EPILOG.replace("{columns}", _columns(calibrate=True)),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    _add_batch_options(p, timeout_s=1800.0)
+    p.set_defaults(run=run_calibrate)
+
+
+def _add_batch_options(p: argparse.ArgumentParser, timeout_s: float = 600.0) -> None:
     p.add_argument("manifest", metavar="MANIFEST", help="CSV or JSON manifest, one job per row")
     p.add_argument("-o", "--output", required=True, metavar="OUTDIR", help="output folder (new, empty, or --resume)")
     p.add_argument("--resume", action="store_true", help="run only the jobs OUTDIR has no finished folder for")
@@ -60,25 +98,36 @@ def register(parser: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--timeout",
         type=float,
-        default=600.0,
+        default=timeout_s,
         metavar="S",
-        help="seconds a job may run before its worker is stopped and it is recorded as failed (default 600; a "
-        "manifest's timeout column overrides it per job)",
+        help=f"seconds a job may run before its worker is stopped and it is recorded as failed (default "
+        f"{timeout_s:g}; a manifest's timeout column overrides it per job)",
     )
     where = p.add_mutually_exclusive_group()
     where.add_argument("--address", metavar="ADDR", help="join this Ray cluster (host:port, or `auto`)")
     where.add_argument("--local", action="store_true", help="run in a process pool on this machine, without Ray")
-    p.set_defaults(run=run_dress)
 
 
-def _columns() -> str:
-    from ..batch.manifest import COLUMNS
+def _columns(calibrate: bool = False) -> str:
+    from ..batch.manifest import CALIBRATE_COLUMNS, COLUMNS
 
-    return "\n".join(f"  {name:13s} {what}" for name, what in COLUMNS.items())
+    return "\n".join(f"  {name:13s} {what}" for name, what in (CALIBRATE_COLUMNS if calibrate else COLUMNS).items())
 
 
 def run_dress(args: argparse.Namespace) -> int:
-    from ..batch import DressKind, LocalRunner, RayRunner, ray_available, read_manifest, run_batch
+    from ..batch import DressKind, read_manifest
+
+    return _run(args, DressKind(), read_manifest, "gave no garment")
+
+
+def run_calibrate(args: argparse.Namespace) -> int:
+    from ..batch import CalibrateKind, read_calibrate_manifest
+
+    return _run(args, CalibrateKind(), read_calibrate_manifest, "gave no table")
+
+
+def _run(args: argparse.Namespace, kind, read, failed_words: str) -> int:  # noqa: ANN001
+    from ..batch import LocalRunner, RayRunner, ray_available, run_batch
     from ..errors import ComputationError, InputError
 
     if args.retry_failed and not args.resume:
@@ -88,12 +137,12 @@ def run_dress(args: argparse.Namespace) -> int:
             "Ray is not installed: pip install 'kitsuke[batch]' to run batches on Ray, or add --local to run this one "
             "in a process pool on this machine"
         )
-    jobs = read_manifest(args.manifest)
+    jobs = read(args.manifest)
     if args.local:
         runner = LocalRunner(workers=args.workers, timeout_s=args.timeout)
     else:
         runner = RayRunner(address=args.address, workers=args.workers, timeout_s=args.timeout)
-    result = run_batch(DressKind(), jobs, args.output, runner, resume=args.resume, retry_failed=args.retry_failed)
+    result = run_batch(kind, jobs, args.output, runner, resume=args.resume, retry_failed=args.retry_failed)
     c = result.counts
     print(
         f"{len(jobs)} jobs: {c['ok']} ok, {c['out_of_target']} out of target, {c['refused']} refused, "
@@ -104,6 +153,6 @@ def run_dress(args: argparse.Namespace) -> int:
     )
     if result.unfinished:
         raise ComputationError(
-            "batch", f"{result.unfinished} of {len(jobs)} jobs gave no garment: see {result.summary_csv}"
+            "batch", f"{result.unfinished} of {len(jobs)} jobs {failed_words}: see {result.summary_csv}"
         )
     return 0
