@@ -34,6 +34,18 @@ CHILDREN: dict[str, tuple[str, ...]] = {j: tuple(c for c in JOINTS if PARENT[c] 
 BONES: tuple[tuple[str, str], ...] = tuple((PARENT[j], j) for j in JOINTS if PARENT[j] is not None)  # type: ignore[misc]
 
 
+def descendants(joint: int) -> list[int]:
+    """The indices of the joints below `joint` in the tree (its children, theirs, ...; not itself), in order."""
+    out = []
+    for j in range(len(JOINTS)):
+        p = PARENT_INDEX[j]
+        while p >= 0 and p != joint:
+            p = PARENT_INDEX[p]
+        if p == joint:
+            out.append(j)
+    return out
+
+
 def joint_index(name: str) -> int:
     """Index of a joint in JOINTS; ValueError naming the valid joints if unknown."""
     try:

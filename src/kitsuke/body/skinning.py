@@ -54,7 +54,7 @@ def skin(
     return np.einsum("vab,vb->va", blend_r, vertices) + weights @ offsets
 
 
-def _rotation_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def rotation_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Smallest rotation taking direction a to direction b (both (3,), any length)."""
     a = a / np.linalg.norm(a)
     b = b / np.linalg.norm(b)
@@ -197,7 +197,7 @@ def rotations_from_positions(rest_joints: np.ndarray, targets: np.ndarray) -> np
         if len(src) == 0:
             rot[j] = base
         elif len(src) == 1:
-            rot[j] = _rotation_between(src[0], dst[0]) @ base
+            rot[j] = rotation_between(src[0], dst[0]) @ base
             limb = LIMBS.get(name)
             if limb is not None:
                 mid, end = INDEX[limb[0]], INDEX[limb[1]]

@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from ..skeleton import BONES, INDEX, JOINTS
+from ..skeleton import BONES, INDEX, JOINTS, descendants
 from . import _kernels as K
 from ._constraints import PAIRS, ConstraintTable, default_constraints
 from ._sequence import PoseSequence
@@ -57,20 +57,9 @@ def _moved_table() -> np.ndarray:
     for p in range(2):
         for s in range(2):
             t = JOINTS[PAIR_JOINTS[p, s]]
-            below = [t] + [j for j in JOINTS if _is_below(j, t)]
+            below = [t] + [JOINTS[j] for j in descendants(INDEX[t])]
             out[p, s, : len(below)] = [INDEX[j] for j in below]
     return out
-
-
-def _is_below(j: str, ancestor: str) -> bool:
-    from ..skeleton import PARENT
-
-    p = PARENT[j]
-    while p is not None:
-        if p == ancestor:
-            return True
-        p = PARENT[p]
-    return False
 
 
 MOVED = _moved_table()

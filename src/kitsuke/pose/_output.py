@@ -24,7 +24,7 @@ from .._prefetch import prefetch
 from .._progress import progress
 from ..errors import InputError
 from ..render.video import mp4_writer
-from ..skeleton import BONES, INDEX, JOINTS
+from ..skeleton import BONES, INDEX, JOINTS, descendants
 from ._constraints import PAIRS
 from ._correct import Correction, regions_of
 
@@ -318,7 +318,7 @@ def write_overlay_video(
             for p in range(2):
                 if correction.rotated[f, p]:
                     tj = int(correction.target[f, p])
-                    highlight |= {tj} | {j for j in range(len(JOINTS)) if _below(j, tj)}
+                    highlight |= {tj, *descendants(tj)}
             if it is None:
                 img = _synthetic_frame(cv2, poses, f, size, scale, pelvis, correction, highlight)
                 _legend(cv2, img, LEGEND, (10, 34))
@@ -362,17 +362,6 @@ def write_overlay_video(
             "worst": round(float(r.max()), 2),
         }
     }
-
-
-def _below(j: int, ancestor: int) -> bool:
-    from ..skeleton import PARENT_INDEX
-
-    p = PARENT_INDEX[j]
-    while p >= 0:
-        if p == ancestor:
-            return True
-        p = PARENT_INDEX[p]
-    return False
 
 
 def check_video_output(path: str | os.PathLike[str]) -> None:

@@ -30,27 +30,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..body.skinning import forward_kinematics
+from ..body.skinning import forward_kinematics, rotation_between
 from ..errors import ComputationError, InputError
-from ..skeleton import INDEX, PARENT_INDEX
+from ..skeleton import INDEX, descendants
 from .simulate import KimonoSimulator, SimulationSettings
 
 #: The joints each pair is measured at, and the leg chain each side's hip turns (everything below the hip).
 _PAIR_JOINTS = {"knee": ("l_knee", "r_knee"), "ankle": ("l_ankle", "r_ankle")}
 
 
-def _below(j: int, ancestor: int) -> bool:
-    while j >= 0:
-        if j == ancestor:
-            return True
-        j = PARENT_INDEX[j]
-    return False
-
-
 def _leg(side: str) -> list[int]:
     """The joints a hip turns: the hip itself and every joint below it."""
     hip = INDEX[f"{side}_hip"]
-    return [j for j in range(len(PARENT_INDEX)) if _below(j, hip)]
+    return [hip, *descendants(hip)]
 
 
 @dataclass(frozen=True)
@@ -119,24 +111,10 @@ def spread_pose(
         r = min(float(np.linalg.norm(horizontal)), 0.999 * length)
         horizontal *= r / max(float(np.linalg.norm(horizontal)), 1e-12)
         new = horizontal + np.array([0.0, -math.sqrt(length * length - r * r), 0.0])
-        rot = _rotation_between(bone, new)
+        rot = rotation_between(bone, new)
         for j in _leg(side):
             rotations[j] = rot
     return rotations
-
-
-def _rotation_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The smallest rotation (3, 3) taking the direction of a to that of b (Rodrigues)."""
-    a = a / np.linalg.norm(a)
-    b = b / np.linalg.norm(b)
-    v = np.cross(a, b)
-    c = float(a @ b)
-    s = float(np.linalg.norm(v))
-    if s < 1e-12:
-        return np.eye(3)
-    k = v / s
-    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + s * kx + (1 - c) * (kx @ kx)
 
 
 def _hull(points_xz: np.ndarray):  # noqa: ANN202 - scipy ConvexHull, or None

@@ -271,16 +271,3 @@ def check_poses(poses) -> None:  # noqa: ANN001
     if bad.any():
         first = int(np.flatnonzero(valid)[np.flatnonzero(bad)[0]])
         raise InputError(f"frame {first} of the poses holds NaN or infinity", where)
-
-
-__all__ = [
-    "SIMULATION_EDGE_CM",
-    "FrameQuality",
-    "KimonoMotion",
-    "KimonoSimulator",
-    "SimulationSettings",
-    "check_poses",
-    "cloth_model",
-    "default_simulation_kimono",
-    "simulate_kimono",
-]
