@@ -28,8 +28,8 @@ GROUPS: dict[str, tuple[str, str]] = {
     "drag": ("drag", "drag a dressed garment along the body, with pins (replays a drags file)"),
     "render": ("render", "render meshes to PNG"),
     "pose": ("pose", "extract poses from video/images/camera/BVH, correct them for a kimono, animate the body"),
-    "kimono": ("kimono", "simulate the kimono on a body moved by poses"),
-    "batch": ("batch", "run many dress jobs from a manifest, on this machine's cores or a Ray cluster"),
+    "kimono": ("kimono", "simulate the kimono on a body moved by poses; calibrate its posture limits E"),
+    "batch": ("batch", "run many dress jobs or kimono calibrations from a manifest, locally or on Ray"),
 }
 
 EPILOG = """\
