@@ -16,6 +16,8 @@ import pytest
 
 from kitsuke.body import default_body
 from kitsuke.body.animate import animate, posed_vertices
+from kitsuke.body.capsules import capsule_segments
+from kitsuke.body.skinning import skin
 from kitsuke.dressing.export import write_garment_obj
 from kitsuke.errors import ComputationError
 from kitsuke.metrics import penetration, strain
@@ -195,6 +197,21 @@ def test_the_animated_glb_plays_the_body_and_the_kimono(tmp_path, body, motion):
         assert report["errors"] == 0 and report["warnings"] == 0, report["messages"]
 
 
+def test_a_kimono_that_leaves_the_body_is_a_failure(body, kimono):
+    anim = animate(body, load_bvh(WALK, stride=4, max_frames=1))
+    sim = KimonoSimulator(body, kimono, anim.weights)
+    rest_rot = np.tile(np.eye(3), (len(body.rig.joints), 1, 1))
+    sim.advance(rest_rot, body.rig.joints, 1 / 30)
+    # the body stands a metre to the side, the obi let go, and the cloth forgets where the skin was
+    far = body.rig.joints + [1.0, 0.0, 0.0]
+    ends, _ = capsule_segments(body.capsules, far, rest_rot)
+    sim.moving.hold = None
+    sim.moving.move_to(ends, skin(body.mesh.vertices, anim.weights, body.rig.joints, rest_rot, far))
+    sim.state.contacts.face[:] = -1
+    with pytest.raises(ComputationError, match="frame 1: the kimono left the body"):
+        sim.advance(rest_rot, far, 1 / 30)
+
+
 def test_a_diverging_simulation_names_the_frame(body, kimono):
     anim = animate(body, load_bvh(WALK, stride=4, max_frames=1))
     sim = KimonoSimulator(body, kimono, anim.weights)
@@ -247,6 +264,8 @@ def test_bad_inputs_exit_2_with_one_line(run_cli, tmp_path, walk):
     assert r.code == 2 and "substeps" in r.err
     r = run_cli("kimono", "simulate", "--poses", tmp_path / "missing.bvh", "-o", out)
     assert r.code == 2 and "not found" in r.err
+    r = run_cli("kimono", "simulate", "--poses", WALK, "--hold", "-1", "-o", out)
+    assert r.code == 2 and "lead-in" in r.err and "dressing" not in r.err  # refused before the kimono is dressed
     assert out.read_bytes() == b"keep"
 
 

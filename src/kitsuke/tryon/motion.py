@@ -51,6 +51,12 @@ def _slerp_from_identity(rotations: np.ndarray, t: float) -> np.ndarray:
     return Rotation.from_rotvec(Rotation.from_matrix(rotations).as_rotvec() * t).as_matrix()
 
 
+def check_lead_in(hold_s: float, blend_s: float) -> None:
+    """InputError unless both lead-in times are finite seconds >= 0."""
+    if not (np.isfinite(hold_s) and hold_s >= 0 and np.isfinite(blend_s) and blend_s >= 0):
+        raise InputError(f"the lead-in needs hold and blend times >= 0 s, got {hold_s} and {blend_s}")
+
+
 def with_lead_in(
     animation: BodyAnimation, rest_joints: np.ndarray, *, hold_s: float = 0.2, blend_s: float = 0.5
 ) -> tuple[BodyAnimation, int]:
@@ -59,8 +65,7 @@ def with_lead_in(
     identity, the root along a straight line, eased in and out). Returns the longer animation and how many
     lead-in frames it starts with; frame times go on at the clip's rate, the clip keeps its own times shifted.
     rest_joints : (J, 3) the body's rest joints, metres."""
-    if not (np.isfinite(hold_s) and hold_s >= 0 and np.isfinite(blend_s) and blend_s >= 0):
-        raise InputError(f"the lead-in needs hold and blend times >= 0 s, got {hold_s} and {blend_s}")
+    check_lead_in(hold_s, blend_s)
     clip = placed_at_rest(animation, rest_joints)
     dt = 1.0 / clip.fps
     n_hold, n_blend = int(round(hold_s / dt)), int(round(blend_s / dt))

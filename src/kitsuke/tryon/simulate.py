@@ -24,11 +24,16 @@ from ..cloth._dynamics import MovingBody
 from ..errors import ComputationError, InputError
 from ..metrics import QualityTargets, penetration, strain
 from ..skeleton import INDEX, JOINTS
-from .motion import with_lead_in
+from .motion import check_lead_in, with_lead_in
 
 #: Target edge length (cm) of the kimono dressed for simulation: about 5,100 vertices on the default kimono
 #: (the demo's 1.5 cm gives 16,000: three times the cost a step, and slower to converge).
 SIMULATION_EDGE_CM = 2.5
+
+
+#: Half the cloth farther than this from the skin (metres) means the simulation lost the kimono: exit 1, nothing
+#: written. Dressed, half of it lies within 4 cm of the skin (sleeves hang off it).
+OFF_BODY_M = 0.15
 
 
 @dataclass(frozen=True)
@@ -48,6 +53,9 @@ class SimulationSettings:
     blend_s: float = 0.5
     dynamics: DynamicsParams = field(default_factory=DynamicsParams)
     targets: QualityTargets = field(default_factory=lambda: QualityTargets.motion())
+
+    def __post_init__(self) -> None:
+        check_lead_in(self.hold_s, self.blend_s)  # before any work: a bad setting should not cost a dressing
 
 
 @dataclass(frozen=True)
@@ -133,7 +141,7 @@ class KimonoSimulator:
     def advance(self, rotations: np.ndarray, joints: np.ndarray, dt: float) -> np.ndarray:
         """Move the body to the pose (J, 3, 3) world rotations, (J, 3) joints (metres) and step the cloth `dt`
         seconds; returns the skin's vertices (Vb, 3). ComputationError ("simulation") names the frame when the
-        cloth diverges."""
+        cloth diverges or leaves the body (`OFF_BODY_M`)."""
         rig = self.body.rig
         skin_v = skin(self.body.mesh.vertices, self.weights, rig.joints, rotations, joints)
         ends, _ = capsule_segments(self.body.capsules, joints, rotations)
@@ -142,6 +150,12 @@ class KimonoSimulator:
             step(self.model, self.state, self.moving, dt, self.settings.dynamics, self.data)
         except ComputationError as e:
             raise ComputationError("simulation", f"frame {self.frames}: {e.message}") from None
+        # a kimono whose cloth mostly left the body is no kimono on it (its sleeves hang up to ~25 cm off)
+        off = float(np.median(self.state.contacts.distance))
+        if off > OFF_BODY_M:
+            raise ComputationError(
+                "simulation", f"frame {self.frames}: the kimono left the body (half its cloth {off:.2f} m off it)"
+            )
         self.frames += 1
         return skin_v
 
