@@ -172,7 +172,6 @@ class _Spread:
         self.hem_y = float(self.sim.state.positions[:, 1].min()) + settings.thresholds.band_m
         jl, jr = (INDEX[j] for j in _PAIR_JOINTS[pair])
         self.distance = float(np.linalg.norm((self.rest[jr] - self.rest[jl])[[0, 2]]))
-        self.baseline = (0.0, 0)
         self.baseline = self._torn_inside(body.mesh.vertices)
 
     def pose(self, distance_m: float, blend: float = 1.0) -> tuple[np.ndarray, np.ndarray]:

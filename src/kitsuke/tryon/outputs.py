@@ -45,7 +45,7 @@ def _frame_meshes(motion: KimonoMotion, body, f: int, kimono: TriMesh, index: np
     return [skin, cloth]
 
 
-def _camera(motion: KimonoMotion, body, size: tuple[int, int], view: str):  # noqa: ANN001, ANN202
+def _camera(motion: KimonoMotion, size: tuple[int, int], view: str):  # noqa: ANN202
     """One camera for the whole clip, framed on everything the body and kimono sweep through."""
     from ..render import frame_camera
 
@@ -75,7 +75,7 @@ def write_kimono_video(
 
     size = (size[0] // 2 * 2, size[1] // 2 * 2)
     kimono, index = kimono_mesh(motion)
-    camera = _camera(motion, body, size, view)
+    camera = _camera(motion, size, view)
     with Renderer() as r, mp4_writer(path, size, motion.animation.fps) as send:
         for f in bar(range(len(motion.quality)), total=len(motion.quality), desc="video", enabled=progress):
             image = r.render(_frame_meshes(motion, body, f, kimono, index), camera=camera, size=size)
@@ -102,7 +102,7 @@ def picture_strip(
     start = motion.n_lead if motion.n_lead < len(motion.quality) else 0
     frames = np.unique(np.linspace(start, len(motion.quality) - 1, n).round().astype(int))
     kimono, index = kimono_mesh(motion)
-    camera = _camera(motion, body, size, view)
+    camera = _camera(motion, size, view)
     with Renderer() as r:
         images = [
             r.render(_frame_meshes(motion, body, int(f), kimono, index), camera=camera, size=size) for f in frames
