@@ -29,8 +29,8 @@ from ._constraints import (
     write_constraints,
     write_default_constraints,
 )
-from ._correct import Correction, check_invariants, correct_poses, correction_measures
-from ._filter import OneEuroConfig, filter_poses, one_euro
+from ._correct import Correction, OnlineCorrector, check_invariants, correct_poses, correction_measures
+from ._filter import OneEuroConfig, OneEuroFilter, filter_poses, one_euro
 from ._landmarks import LANDMARKS, image_to_joints, world_to_joints
 from ._mediapipe import PoseLandmarker, extract_camera, extract_images, extract_video
 from ._output import fit_affine_camera, plot_distances, write_overlay_video
@@ -44,6 +44,8 @@ __all__ = [
     "Correction",
     "KimonoLegGeometry",
     "OneEuroConfig",
+    "OneEuroFilter",
+    "OnlineCorrector",
     "PairLimit",
     "PoseLandmarker",
     "PoseSequence",

@@ -150,54 +150,120 @@ def correct_poses(
     side_margin_m : a rotated leg joint may end at most this far on the other side of the sagittal plane than its
         raw position, metres. `inf` for both gives the SPEC's rotation without the plausibility rules.
     """
-    if not (tolerance_m > 0):
-        raise ValueError(f"tolerance_m must be positive, got {tolerance_m}")
-    if samples < 4:
-        raise ValueError(f"samples must be at least 4, got {samples}")
     table = constraints if constraints is not None else default_constraints()
-    tt, ee, area = _tables(table)
+    rules = _rules(table, tolerance_m, samples, max_jump_m, side_margin_m)
     pos = np.ascontiguousarray(poses.positions, dtype=np.float64)
     n = len(pos)
-    out = pos.copy()
-    target = -np.ones((n, 2), dtype=np.int64)
-    angle = np.zeros((n, 2))
-    residual = np.zeros((n, 2))
-    regions = np.full((n, 2, 6), np.nan)
-    status = np.full((n, 2), K.INVALID, dtype=np.int8)
-    stage_input = np.full((n, 2, 3), np.nan)
-    axes = np.zeros((n, 2, 3))
-    args = (
-        pos,
-        np.ascontiguousarray(poses.valid),
-        tt,
-        ee,
-        area,
-        PAIR_JOINTS,
-        START_JOINTS,
-        MOVED,
-        INDEX["l_hip"],
-        INDEX["r_hip"],
-        INDEX["pelvis"],
-        float(tolerance_m),
-        int(samples),
-        float(max_jump_m),
-        float(side_margin_m),
-    )
+    rows = _Rows(n, pos.copy())
     t0 = time.perf_counter()
-    K.correct_frames(*args, out, target, angle, residual, regions, status, stage_input, axes)
+    K.correct_frames(pos, np.ascontiguousarray(poses.valid), *rules, *rows.outputs(), 0)
     seconds = time.perf_counter() - t0
+    target, status = rows.target, rows.status
     rotated = np.isin(status, K.ROTATING)
     corrected = [tuple(JOINTS[target[f, p]] for p in range(2) if rotated[f, p]) for f in range(n)]
     src = dict(poses.source)
     result = replace(
         poses.copy(),
-        positions=out,
+        positions=rows.out,
         raw_positions=pos.copy(),
         corrected=corrected,
         constraints=table,
         source=src,
     )
-    return Correction(result, target, angle, residual, regions, status, seconds, stage_input)
+    return Correction(result, target, rows.angle, rows.residual, rows.regions, status, seconds, rows.stage_input)
+
+
+def _rules(table: ConstraintTable, tolerance_m: float, samples: int, max_jump_m: float, side_margin_m: float) -> tuple:
+    """The kernel's fixed arguments between the poses and the outputs (checked)."""
+    if not (tolerance_m > 0):
+        raise ValueError(f"tolerance_m must be positive, got {tolerance_m}")
+    if samples < 4:
+        raise ValueError(f"samples must be at least 4, got {samples}")
+    tt, ee, area = _tables(table)
+    return (
+        tt, ee, area, PAIR_JOINTS, START_JOINTS, MOVED, INDEX["l_hip"], INDEX["r_hip"], INDEX["pelvis"],
+        float(tolerance_m), int(samples), float(max_jump_m), float(side_margin_m),
+    )  # fmt: skip
+
+
+class _Rows:
+    """The kernel's per-frame outputs for n frames (see `Correction`); `out` starts as the input poses."""
+
+    def __init__(self, n: int, out: np.ndarray) -> None:
+        self.out = out
+        self.target = -np.ones((n, 2), dtype=np.int64)
+        self.angle = np.zeros((n, 2))
+        self.residual = np.zeros((n, 2))
+        self.regions = np.full((n, 2, 6), np.nan)
+        self.status = np.full((n, 2), K.INVALID, dtype=np.int8)
+        self.stage_input = np.full((n, 2, 3), np.nan)
+        self.axes = np.zeros((n, 2, 3))
+
+    def outputs(self) -> tuple:
+        return self.out, self.target, self.angle, self.residual, self.regions, self.status, self.stage_input, self.axes
+
+    def shift(self) -> None:
+        """Row 1 becomes row 0 (the previous frame of a two-row window)."""
+        for a in self.outputs():
+            a[0] = a[1]
+
+
+class OnlineCorrector:
+    """`correct_poses` one frame at a time, for a live camera: each call corrects a frame from the previous frame's
+    result, exactly as the whole-sequence correction would (the same kernel; equal results, tested).
+
+    corrector = OnlineCorrector()             # the shipped constraints
+    fixed = corrector(joints)                 # (J, 3) raw joints, metres, Y up -> (J, 3) corrected (a new array)
+    corrector(None)                           # a frame without a pose: the next one starts afresh
+    corrector.status, corrector.target        # (2,) this frame's status and target per pair (knees, ankles)
+    """
+
+    def __init__(
+        self,
+        constraints: ConstraintTable | None = None,
+        *,
+        tolerance_m: float = 1e-4,
+        samples: int = 64,
+        max_jump_m: float = MAX_JUMP_M,
+        side_margin_m: float = SIDE_MARGIN_M,
+    ) -> None:
+        self.constraints = constraints if constraints is not None else default_constraints()
+        self._rules = _rules(self.constraints, tolerance_m, samples, max_jump_m, side_margin_m)
+        self._raw = np.zeros((2, len(JOINTS), 3))
+        self._valid = np.zeros(2, dtype=bool)
+        self._rows = _Rows(2, np.zeros((2, len(JOINTS), 3)))
+
+    def __call__(self, joints: np.ndarray | None) -> np.ndarray | None:
+        rows = self._rows
+        rows.shift()
+        self._raw[0] = self._raw[1]
+        self._valid[0] = self._valid[1]
+        if joints is None:
+            self._valid[1] = False
+            rows.status[1] = K.INVALID
+            rows.target[1] = -1
+            return None
+        q = np.asarray(joints, dtype=np.float64)
+        self._raw[1] = q
+        rows.out[1] = q
+        self._valid[1] = True
+        K.correct_frames(self._raw, self._valid, *self._rules, *rows.outputs(), 1)
+        return rows.out[1].copy()
+
+    @property
+    def status(self) -> np.ndarray:
+        """(2,) int8 the last frame's status per pair (knees, ankles): see `STATUS`."""
+        return self._rows.status[1].copy()
+
+    @property
+    def target(self) -> np.ndarray:
+        """(2,) int64 the last frame's target joint per pair, -1 where none."""
+        return self._rows.target[1].copy()
+
+    @property
+    def rotated(self) -> bool:
+        """The last frame had a leg segment rotated."""
+        return bool(np.isin(self._rows.status[1], K.ROTATING).any())
 
 
 # ------------------------------------------------------------------------------------------- regions in numpy

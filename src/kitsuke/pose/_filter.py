@@ -49,6 +49,42 @@ def _alpha(cutoff_hz: np.ndarray | float, dt: float) -> np.ndarray | float:
     return 1.0 / (1.0 + 1.0 / (2.0 * math.pi * cutoff_hz * dt))
 
 
+class OneEuroFilter:
+    """The One-Euro filter fed one sample at a time (a live camera); `one_euro` runs it over a whole signal.
+
+    f = OneEuroFilter(OneEuroConfig()); smoothed = f(x, t)   # x: array of any shape, t: seconds (non-decreasing)
+    """
+
+    def __init__(self, config: OneEuroConfig | None = None) -> None:
+        self.config = config or OneEuroConfig()
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the past: the next sample passes through (a new person, a new clip)."""
+        self._x: np.ndarray | None = None
+        self._dx: np.ndarray | None = None
+        self._t = 0.0
+
+    def __call__(self, x: np.ndarray, t: float) -> np.ndarray:
+        """The filtered value of sample `x` at time `t` seconds (a new float64 array)."""
+        x = np.array(x, dtype=np.float64, copy=True)
+        cfg = self.config
+        if not cfg.enabled:
+            return x
+        if self._x is None:
+            self._x, self._dx, self._t = x.copy(), np.zeros_like(x), float(t)
+            return x
+        dt = float(t) - self._t
+        if dt <= 0:  # repeated timestamp: keep the previous estimate's state, pass the value through smoothed
+            dt = 1e-3
+        a_d = _alpha(cfg.d_cutoff_hz, dt)
+        dx = a_d * (x - self._x) / dt + (1.0 - a_d) * self._dx
+        a = _alpha(cfg.min_cutoff_hz + cfg.beta * np.abs(dx), dt)
+        x_hat = a * x + (1.0 - a) * self._x
+        self._x, self._dx, self._t = x_hat, dx, float(t)
+        return x_hat.copy()
+
+
 def one_euro(values: np.ndarray, times: np.ndarray, valid: np.ndarray, config: OneEuroConfig) -> np.ndarray:
     """Filter a signal over time.
 
@@ -63,27 +99,9 @@ def one_euro(values: np.ndarray, times: np.ndarray, valid: np.ndarray, config: O
     (n, ...) float64 filtered values (a new array).
     """
     out = np.array(values, dtype=np.float64, copy=True)
-    if not config.enabled:
-        return out
-    x_prev: np.ndarray | None = None
-    dx_prev: np.ndarray | None = None
-    t_prev = 0.0
-    a_d = 0.0
+    f = OneEuroFilter(config)
     for i in np.flatnonzero(valid):
-        x = out[i]
-        if x_prev is None:
-            x_prev, dx_prev, t_prev = x.copy(), np.zeros_like(x), float(times[i])
-            continue
-        dt = float(times[i]) - t_prev
-        if dt <= 0:  # repeated timestamp: keep the previous estimate's state, pass the value through smoothed
-            dt = 1e-3
-        a_d = _alpha(config.d_cutoff_hz, dt)
-        dx = a_d * (x - x_prev) / dt + (1.0 - a_d) * dx_prev
-        cutoff = config.min_cutoff_hz + config.beta * np.abs(dx)
-        a = _alpha(cutoff, dt)
-        x_hat = a * x + (1.0 - a) * x_prev
-        out[i] = x_hat
-        x_prev, dx_prev, t_prev = x_hat, dx, float(times[i])
+        out[i] = f(out[i], times[i])
     return out
 
 

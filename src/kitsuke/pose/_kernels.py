@@ -365,6 +365,7 @@ def correct_frames(
     status: np.ndarray,  # (n, 2) int8 out
     stage_input: np.ndarray,  # (n, 2, 3) out: the target's position when its pass started (before rotation)
     axes: np.ndarray,  # (n, 2, 3) out: the rotation axis, where a segment was rotated
+    start: int,  # first frame to correct; rows before it hold earlier results (online use: one frame at a time)
 ) -> None:
     n = positions.shape[0]
     k_now = np.empty(6)
@@ -376,8 +377,8 @@ def correct_frames(
     pt2 = np.empty(3)
     rules = np.array([0.0, 0.0, 1.0, 0.0, max_jump, margin, 1.0])
     e2 = np.empty(3)
-    prev_valid = False
-    for f in range(n):
+    prev_valid = start > 0 and valid[start - 1]
+    for f in range(start, n):
         if not valid[f]:
             prev_valid = False
             for p in range(2):

@@ -89,6 +89,7 @@ class PoseLandmarker:
     ----------
     mode : "video" (frames of one sequence, tracked; timestamps must increase) or "image" (independent images).
     min_detection_confidence, min_presence_confidence, min_tracking_confidence : MediaPipe's thresholds, in [0, 1].
+    num_poses : how many people to look for (`detect_all`); `detect` gives the most prominent.
     """
 
     def __init__(
@@ -98,10 +99,12 @@ class PoseLandmarker:
         min_detection_confidence: float = 0.5,
         min_presence_confidence: float = 0.5,
         min_tracking_confidence: float = 0.5,
+        num_poses: int = 1,
     ):
         if mode not in ("video", "image"):
             raise ValueError(f"mode must be 'video' or 'image', got {mode!r}")
         self.mode = mode
+        self.num_poses = int(num_poses)
         self._opts = (min_detection_confidence, min_presence_confidence, min_tracking_confidence)
         self._landmarker: Any = None
         self._stack = contextlib.ExitStack()
@@ -115,7 +118,7 @@ class PoseLandmarker:
         options = vision.PoseLandmarkerOptions(
             base_options=BaseOptions(model_asset_path=str(path)),
             running_mode=running,
-            num_poses=1,
+            num_poses=self.num_poses,
             min_pose_detection_confidence=self._opts[0],
             min_pose_presence_confidence=self._opts[1],
             min_tracking_confidence=self._opts[2],
@@ -142,6 +145,11 @@ class PoseLandmarker:
         (world, image): (33, 3) float64 MediaPipe world landmarks (metres, hip-centred, y down, z away from the
         camera) and (33, 3) float64 pixels u, v with visibility in [0, 1].
         """
+        people = self.detect_all(rgb, timestamp_ms)
+        return people[0] if people else None
+
+    def detect_all(self, rgb: np.ndarray, timestamp_ms: int | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Landmarks of up to `num_poses` people, as `detect` gives them for one (an empty list for nobody)."""
         import mediapipe as mp
 
         if self._landmarker is None:
@@ -154,17 +162,17 @@ class PoseLandmarker:
             result = self._landmarker.detect_for_video(frame, ms)
         else:
             result = self._landmarker.detect(frame)
-        if not result.pose_world_landmarks:
-            return None
         h, w = rgb.shape[:2]
-        world = np.array([[p.x, p.y, p.z] for p in result.pose_world_landmarks[0]], dtype=np.float64)
-        image = np.array(
-            [[p.x * w, p.y * h, p.visibility if p.visibility is not None else 0.0] for p in result.pose_landmarks[0]],
-            dtype=np.float64,
-        )
-        if world.shape != (33, 3) or not np.isfinite(world).all():
-            return None
-        return world, image
+        people = []
+        for world_lm, image_lm in zip(result.pose_world_landmarks, result.pose_landmarks, strict=False):
+            world = np.array([[p.x, p.y, p.z] for p in world_lm], dtype=np.float64)
+            image = np.array(
+                [[p.x * w, p.y * h, p.visibility if p.visibility is not None else 0.0] for p in image_lm],
+                dtype=np.float64,
+            )
+            if world.shape == (33, 3) and image.shape == (33, 3) and np.isfinite(world).all():
+                people.append((world, image))
+        return people
 
 
 def _collect(

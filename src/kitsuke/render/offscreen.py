@@ -132,6 +132,7 @@ class Renderer:
         supersample: int = 1,
         fov_y_deg: float = 30.0,
         margin: float = 0.05,
+        occluders: Sequence[TriMesh] = (),
     ) -> np.ndarray:
         """Render meshes into an image.
 
@@ -151,6 +152,8 @@ class Renderer:
         supersample : render at this many times the size and average down (more anti-aliasing; cost ~ square).
         fov_y_deg, margin : vertical field of view (degrees) and free border (fraction of the image) of the
             auto-framed views.
+        occluders : meshes drawn into depth only, before the others: invisible, they hide what lies behind them
+            (a body hiding the inside and back of a garment composited over a photo of the person).
 
         Returns
         -------
@@ -159,7 +162,8 @@ class Renderer:
         mesh_list = [meshes] if isinstance(meshes, TriMesh) else list(meshes)
         if not mesh_list:
             raise InputError("no meshes to render")
-        for m in mesh_list:
+        hidden = list(occluders)
+        for m in mesh_list + hidden:
             _check_mesh(m)
         width, height = _check_size(size, self.max_size, supersample, samples)
         if shading not in ("smooth", "flat"):
@@ -170,7 +174,7 @@ class Renderer:
             camera = frame_camera(all_vertices, view, aspect=width / height, fov_y_deg=fov_y_deg, margin=margin)
         gradient = _background_colors(background)
         ss_size = (width * supersample, height * supersample)
-        image = self._draw(mesh_list, mesh_colors, camera, ss_size, wireframe, shading, samples, gradient)
+        image = self._draw(mesh_list, mesh_colors, camera, ss_size, wireframe, shading, samples, gradient, hidden)
         if supersample > 1:
             c = image.shape[2]
             blocks = image.reshape(height, supersample, width, supersample, c).astype(np.float32)
@@ -207,6 +211,7 @@ class Renderer:
         shading: str,
         samples: int,
         background: tuple[tuple[float, float, float], tuple[float, float, float]] | None,
+        occluders: list[TriMesh],
     ) -> np.ndarray:
         """Draw into the (MSAA) framebuffer and read it back: (H, W, 3) uint8 RGB over the background, or
         (H, W, 4) straight-alpha RGBA on a transparent background (None); top row first."""
@@ -225,7 +230,7 @@ class Renderer:
             self._background_vao.render(moderngl.TRIANGLES, vertices=3)
         ctx.enable(moderngl.DEPTH_TEST)
 
-        near, far = camera.depth_range(np.concatenate([m.vertices for m in meshes]))
+        near, far = camera.depth_range(np.concatenate([m.vertices for m in meshes + occluders]))
         view_proj = camera.projection_matrix(size[0] / size[1], near, far) @ camera.view_matrix()
         right, up, back = camera.basis()
         # Lights fixed to the camera: key from upper left and a little in front, fill from the right.
@@ -241,19 +246,16 @@ class Renderer:
         prog["u_unindexed"].value = wireframe
         prog["u_texture"].value = 0
 
+        if occluders:
+            fbo.color_mask = (False, False, False, False)
+            fbo.use()  # moderngl applies a framebuffer's masks when it is bound
+            for mesh in occluders:
+                self._draw_mesh(mesh, unindexed=wireframe)
+            fbo.color_mask = (True, True, True, True)
+            fbo.use()
         for mesh, color in zip(meshes, colors, strict=True):
-            resources = self._upload(mesh, unindexed=wireframe)
-            try:
-                vao, texture = resources[0], resources[-1]
-                prog["u_color"].value = _linear(color)
-                prog["u_textured"].value = texture is not None
-                if texture is not None:
-                    texture.use(0)
-                vao.render(moderngl.TRIANGLES)
-            finally:
-                for obj in resources:
-                    if obj is not None:
-                        obj.release()
+            prog["u_color"].value = _linear(color)
+            self._draw_mesh(mesh, unindexed=wireframe)
 
         if samples > 1:
             ctx.copy_framebuffer(fbos[4], fbo)
@@ -264,6 +266,20 @@ class Renderer:
         if background is None:
             _unpremultiply(image)
         return image
+
+    def _draw_mesh(self, mesh: TriMesh, *, unindexed: bool) -> None:
+        """Upload one mesh, draw it with the program's current settings, and release it."""
+        resources = self._upload(mesh, unindexed=unindexed)
+        try:
+            texture = resources[-1]
+            self.program["u_textured"].value = texture is not None
+            if texture is not None:
+                texture.use(0)
+            resources[0].render(self._moderngl.TRIANGLES)
+        finally:
+            for obj in resources:
+                if obj is not None:
+                    obj.release()
 
     def _upload(self, mesh: TriMesh, *, unindexed: bool) -> tuple:
         """Vertex array (and buffers, texture) of one mesh: position, normal, uv as float32."""

@@ -16,17 +16,26 @@ from .simulate import KimonoMotion
 TEXTURE_REPEAT_CM = 3.0
 
 
-def kimono_mesh(motion: KimonoMotion, frame: int = 0, *, textured: bool = True) -> tuple[TriMesh, np.ndarray]:
-    """The kimono at `frame` as viewers see it (vertices split at seams, asanoha texture on the pattern's uv),
-    and (V',) the simulated vertex of each of its vertices."""
-    from ..dressing.export import viewer_vertices
+def kimono_template(garment, *, textured: bool = True) -> tuple[TriMesh, np.ndarray]:  # noqa: ANN001
+    """A dressed kimono as viewers see it (vertices split at seams, asanoha texture on the pattern's uv), and
+    (V',) the cloth vertex of each of its vertices: `mesh.vertices = positions[index]` poses it."""
+    from ..dressing.export import as_garment_file, viewer_vertices
     from ..pattern import kimono_texture, texture_tile_size_cm
 
-    index, faces, uv = viewer_vertices(motion.garment)
+    index, faces, uv = viewer_vertices(garment)
     tile_m = texture_tile_size_cm("asanoha", TEXTURE_REPEAT_CM)[0] / 100
     texture = kimono_texture(motif="asanoha", repeat_cm=TEXTURE_REPEAT_CM, px_per_cm=64) if textured else None
-    positions = motion.positions[frame].astype(np.float64)[index]
+    positions = np.asarray(as_garment_file(garment).positions, dtype=np.float64)[index]
     return TriMesh(positions, faces, uv / tile_m, name="kimono", texture=texture), index
+
+
+def kimono_mesh(motion: KimonoMotion, frame: int = 0, *, textured: bool = True) -> tuple[TriMesh, np.ndarray]:
+    """The kimono at `frame` as viewers see it (`kimono_template`), and (V',) the simulated vertex of each of its
+    vertices."""
+    mesh, index = kimono_template(motion.garment, textured=textured)
+    return TriMesh(
+        motion.positions[frame].astype(np.float64)[index], mesh.faces, mesh.uv, name="kimono", texture=mesh.texture
+    ), index
 
 
 def write_kimono_glb(motion: KimonoMotion, body, path: str | os.PathLike[str]) -> Path:  # noqa: ANN001 - Body

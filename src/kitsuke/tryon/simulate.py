@@ -212,16 +212,16 @@ class KimonoMotion:
         }
 
 
-def default_simulation_kimono(body=None, pattern=None):  # noqa: ANN001, ANN201 - Body, Pattern -> DressedGarment
+def default_simulation_kimono(body=None, pattern=None, edge_cm: float = SIMULATION_EDGE_CM):  # noqa: ANN001, ANN201
     """A kimono dressed on `body` (default: the default body) for simulation: `pattern` (default
-    `default_kimono()`) at `SIMULATION_EDGE_CM`, without the polish's refinement of folds (its 3 mm edges, sqrt(3)
-    levels down from 2.5 cm, are crushed and jitter in a moving simulation: on a walk, 96 % of the edges strained
-    over 10 % in its first frames were such edges)."""
+    `default_kimono()`) at `edge_cm` (default `SIMULATION_EDGE_CM`), without the polish's refinement of folds
+    (its 3 mm edges, sqrt(3) levels down from 2.5 cm, are crushed and jitter in a moving simulation: on a walk,
+    96 % of the edges strained over 10 % in its first frames were such edges)."""
     from ..dressing.kimono import dress_kimono
     from ..dressing.wrap import WrapParams
     from ..pattern import default_kimono
 
-    params = WrapParams(edge_length_cm=SIMULATION_EDGE_CM, polish_refine_levels=0)
+    params = WrapParams(edge_length_cm=edge_cm, polish_refine_levels=0)
     return dress_kimono(default_kimono() if pattern is None else pattern, body, params=params)
 
 
