@@ -29,6 +29,7 @@ GROUPS: dict[str, tuple[str, str]] = {
     "render": ("render", "render meshes to PNG"),
     "pose": ("pose", "extract poses from video/images/camera/BVH, correct them for a kimono, animate the body"),
     "kimono": ("kimono", "simulate the kimono on a body moved by poses; calibrate its posture limits E"),
+    "tryon": ("tryon", "the kimono try-on mirror: video, images or camera in, the person wearing a kimono out"),
     "batch": ("batch", "run many dress jobs or kimono calibrations from a manifest, locally or on Ray"),
 }
 
@@ -47,6 +48,7 @@ examples:
   kitsuke pose animate walk.bvh -o walk.glb        # the default body, skinned and animated
   kitsuke kimono simulate --poses walk.bvh -o walk_kimono.glb --video walk_kimono.mp4   # the kimono moving
   kitsuke kimono calibrate -o limits.json --plot limits.png                          # E(θ) by simulation
+  kitsuke tryon clip.mp4 -o clip_kimono.mp4 --compare   # the try-on mirror on a video (--camera 0 --window: live)
   kitsuke batch dress jobs.csv -o out/            # one dress per manifest row, on every core (or --address)
 
 Run `kitsuke <group> --help` for a group's verbs and options.

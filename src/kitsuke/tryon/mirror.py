@@ -92,6 +92,17 @@ def _area(image: np.ndarray) -> float:
     return float(np.prod(pts.max(axis=0) - pts.min(axis=0)))
 
 
+@dataclass(frozen=True)
+class Observation:
+    """The pose stage's result for one frame: people found, (J, 3) filtered joints (metres, Y up) and (J, 3) image
+    joints (u, v pixels, visibility) of the largest person, or None; seconds it took."""
+
+    people: int
+    joints: np.ndarray | None
+    image: np.ndarray | None
+    seconds: float
+
+
 class PoseStage:
     """MediaPipe on a frame, the largest person kept, joints filtered. Use as a context manager."""
 
@@ -138,14 +149,26 @@ class BodyStage:
         self._lowest: deque[float] = deque(maxlen=window)
 
     def __call__(self, joints: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(J, 3, 3) world rotations and (J, 3) posed joints, metres."""
+        """(J, 3, 3) world rotations and (J, 3) posed joints, metres; this frame's feet count toward the floor."""
+        rot, posed = self._posed(joints)
+        self._lowest.append(float(posed[_FEET, 1].min()))
+        posed[:, 1] -= self._lift()
+        return rot, posed
+
+    def pose(self, joints: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The same for another pose of the same frame (the uncorrected one), on the same floor."""
+        rot, posed = self._posed(joints)
+        posed[:, 1] -= self._lift()
+        return rot, posed
+
+    def _posed(self, joints: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         from ..body.skinning import forward_kinematics, rotations_from_positions
 
         rot = rotations_from_positions(self.rest, joints)
-        posed = forward_kinematics(self.rest, rot, joints[INDEX["pelvis"]])
-        self._lowest.append(float(posed[_FEET, 1].min()))
-        posed[:, 1] -= float(np.percentile(self._lowest, 5)) - self._floor
-        return rot, posed
+        return rot, forward_kinematics(self.rest, rot, joints[INDEX["pelvis"]])
+
+    def _lift(self) -> float:
+        return float(np.percentile(self._lowest, 5)) - self._floor
 
 
 class KimonoStage:
@@ -292,6 +315,7 @@ class TryOn:
         self.raw_kimono = KimonoStage(self.body, garment, weights, s) if compare else None
         self.registrar: Registrar | None = None
         self.compositor = Compositor(self.body, garment) if render else None
+        self.correct = s.correct  # the live window's `c` switches it
         self._last_pose_t: float | None = None
         self._last_t: float | None = None
 
@@ -312,32 +336,43 @@ class TryOn:
 
     def step(self, frame: Frame) -> MirrorFrame:
         """Process one frame: returns it with the kimono drawn over it, and its measures."""
+        return self.dress(frame, self.observe(frame))
+
+    def observe(self, frame: Frame) -> Observation:
+        """The pose stage alone (a live mirror runs it in its own thread, overlapping the previous frame's
+        simulation and render)."""
+        t0 = time.perf_counter()
+        people, raw, image = self.poses(frame)
+        return Observation(people, raw, image, time.perf_counter() - t0)
+
+    def dress(self, frame: Frame, seen: Observation) -> MirrorFrame:
+        """Everything after the pose: correction, body, simulation, registration, render."""
         s = self.settings
-        out = MirrorFrame(frame.index, frame.time_s)
+        out = MirrorFrame(frame.index, frame.time_s, people=seen.people, stage_s={"pose": seen.seconds})
         timer = _Timer(out.stage_s)
         if self.registrar is None:
             self.registrar = Registrar((frame.rgb.shape[1], frame.rgb.shape[0]), s.focal_frames)
-        with timer("pose"):
-            out.people, raw, image = self.poses(frame)
         dt = self._dt(frame.time_s)
-        gone = self._last_pose_t is not None and frame.time_s - self._last_pose_t >= s.fade_s
+        raw, image = seen.joints, seen.image
         if raw is None:
             self.corrector(None)
-            out.alpha = (
-                0.0 if self._last_pose_t is None else max(0.0, 1.0 - (frame.time_s - self._last_pose_t) / s.fade_s)
-            )
-            if gone:  # faded out: the next person is dressed afresh
+            since = None if self._last_pose_t is None else frame.time_s - self._last_pose_t
+            out.alpha = 0.0 if since is None else max(0.0, 1.0 - since / s.fade_s)
+            if since is not None and since >= s.fade_s:  # faded out: whoever comes next is dressed afresh
                 self.kimono.stop()
                 if self.raw_kimono is not None:
                     self.raw_kimono.stop()
                 self.poses.reset()
+                self._last_pose_t = None
         else:
             with timer("correct"):
-                fixed = self.corrector(raw) if s.correct else raw
-                out.corrected = s.correct and self.corrector.rotated
+                fixed = self.corrector(raw)  # always run, so that switching `correct` on mid-run starts smoothly
+                if not self.correct:
+                    fixed = raw
+                out.corrected = self.correct and self.corrector.rotated
             with timer("body"):
                 rot, joints = self.posing(fixed)
-                raw_rot, raw_posed = (rot, joints) if fixed is raw else self.posing(raw)
+                raw_rot, raw_posed = (rot, joints) if fixed is raw else self.posing.pose(raw)
             with timer("simulate"):
                 for stage, (r, j) in ((self.kimono, (rot, joints)), (self.raw_kimono, (raw_rot, raw_posed))):
                     if stage is None:
