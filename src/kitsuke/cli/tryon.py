@@ -56,6 +56,7 @@ def register(parser: argparse.ArgumentParser) -> None:
         metavar="CM",
         help="the kimono's mesh edge length (default 2.5 for files, 4 in the window: faster, coarser folds)",
     )
+    parser.add_argument("--max-frames", type=int, metavar="N", help="stop after N frames")
     parser.add_argument("--snapshots", default=".", metavar="DIR", help="where `s` saves snapshots (default .)")
     parser.set_defaults(run=run)
 
@@ -85,11 +86,11 @@ def run(args: argparse.Namespace) -> int:
     table = load_constraints(args.constraints) if args.constraints else None
     edge = args.edge_cm or (LIVE_EDGE_CM if args.window else SIMULATION_EDGE_CM)
     settings = TryOnSettings(correct=args.correct, edge_cm=edge)
-    print("dressing the kimono on the default body ...", file=sys.stderr)
     if args.window:
         from ..tryon.live import Window, run_live
 
-        window = Window()
+        window = Window()  # no display: said before any work
+        print("dressing the kimono on the default body ...", file=sys.stderr)
         try:
             result = run_live(
                 source, window, settings=settings, constraints=table, snapshots=args.snapshots,
@@ -104,9 +105,10 @@ def run(args: argparse.Namespace) -> int:
     else:
         from ..tryon import run_tryon
 
+        print("dressing the kimono on the default body ...", file=sys.stderr)
         result = run_tryon(
             source, args.output, report=args.report, compare=args.compare, plot=args.plot, settings=settings,
-            constraints=table, fps=args.fps,
+            constraints=table, fps=args.fps, max_frames=args.max_frames,
         )  # fmt: skip
     summary = result.summary()
     summary.pop("per_frame")

@@ -96,6 +96,9 @@ class Renderer:
         self.max_samples = int(self.ctx.max_samples)
         self.max_size = int(self.ctx.info.get("GL_MAX_RENDERBUFFER_SIZE", 4096))
         self._fbos: dict[tuple[int, int, int], tuple] = {}
+        # textures kept across renders (a video draws the same garment texture every frame: its upload and
+        # mipmaps cost about as much as the draw): id -> (the image, kept alive so the id stays its own; texture)
+        self._textures: dict[int, tuple[np.ndarray, object]] = {}
 
     # -- lifecycle ------------------------------------------------------------------------------------------
     def close(self) -> None:
@@ -103,6 +106,9 @@ class Renderer:
             for obj in fbos:
                 obj.release()
         self._fbos.clear()
+        for _, texture in self._textures.values():
+            texture.release()
+        self._textures.clear()
         self.ctx.release()
 
     def __enter__(self) -> Renderer:
@@ -250,7 +256,7 @@ class Renderer:
             fbo.color_mask = (False, False, False, False)
             fbo.use()  # moderngl applies a framebuffer's masks when it is bound
             for mesh in occluders:
-                self._draw_mesh(mesh, unindexed=wireframe)
+                self._draw_mesh(mesh, unindexed=wireframe, shaded=False)
             fbo.color_mask = (True, True, True, True)
             fbo.use()
         for mesh, color in zip(meshes, colors, strict=True):
@@ -267,11 +273,12 @@ class Renderer:
             _unpremultiply(image)
         return image
 
-    def _draw_mesh(self, mesh: TriMesh, *, unindexed: bool) -> None:
-        """Upload one mesh, draw it with the program's current settings, and release it."""
-        resources = self._upload(mesh, unindexed=unindexed)
+    def _draw_mesh(self, mesh: TriMesh, *, unindexed: bool, shaded: bool = True) -> None:
+        """Upload one mesh, draw it with the program's current settings, and release it. shaded : False for a
+        depth-only occluder (no normals to compute)."""
+        resources = self._upload(mesh, unindexed=unindexed, normals=shaded)
         try:
-            texture = resources[-1]
+            texture = self._texture(mesh.texture) if mesh.texture is not None else None
             self.program["u_textured"].value = texture is not None
             if texture is not None:
                 texture.use(0)
@@ -281,12 +288,30 @@ class Renderer:
                 if obj is not None:
                     obj.release()
 
-    def _upload(self, mesh: TriMesh, *, unindexed: bool) -> tuple:
-        """Vertex array (and buffers, texture) of one mesh: position, normal, uv as float32."""
+    def _texture(self, image: np.ndarray):  # noqa: ANN202 - a moderngl Texture
+        """The GPU texture of an (H, W, 3|4) uint8 image, uploaded once per image (the same array object)."""
+        key = id(image)
+        if key in self._textures and self._textures[key][0] is image:
+            return self._textures[key][1]
+        if len(self._textures) >= 8:
+            self._textures.pop(next(iter(self._textures)))[1].release()
+        flipped = np.ascontiguousarray(image[::-1])  # uv v = 0 is the image's bottom row
+        texture = self.ctx.texture(flipped.shape[1::-1], flipped.shape[2], flipped.tobytes())
+        texture.build_mipmaps()
+        texture.filter = (self._moderngl.LINEAR_MIPMAP_LINEAR, self._moderngl.LINEAR)
+        # No anisotropic filtering: llvmpipe (the CPU renderer) does it in software, and a textured garment seen
+        # edge-on took 77 s per view at 8x (0.3 s without).
+        texture.anisotropy = 1.0
+        texture.repeat_x = texture.repeat_y = True
+        self._textures[key] = (image, texture)
+        return texture
+
+    def _upload(self, mesh: TriMesh, *, unindexed: bool, normals: bool = True) -> tuple:
+        """Vertex array and buffers of one mesh: position, normal (zero unless `normals`), uv as float32."""
         ctx, prog = self.ctx, self.program
-        normals = mesh.vertex_normals.astype(np.float32)
+        normal = mesh.vertex_normals.astype(np.float32) if normals else np.zeros((mesh.n_vertices, 3), np.float32)
         uv = mesh.uv if mesh.uv is not None else np.zeros((mesh.n_vertices, 2))
-        data = np.concatenate([mesh.vertices.astype(np.float32), normals, uv.astype(np.float32)], axis=1)
+        data = np.concatenate([mesh.vertices.astype(np.float32), normal, uv.astype(np.float32)], axis=1)
         faces = mesh.faces.astype(np.int32)
         if unindexed:
             # Three vertices per triangle so the shader can number the corners (wireframe).
@@ -301,17 +326,7 @@ class Renderer:
             index_buffer=ibo,
             index_element_size=4,
         )
-        texture = None
-        if mesh.texture is not None:
-            image = np.ascontiguousarray(mesh.texture[::-1])  # uv v = 0 is the image's bottom row
-            texture = ctx.texture(image.shape[1::-1], image.shape[2], image.tobytes())
-            texture.build_mipmaps()
-            texture.filter = (self._moderngl.LINEAR_MIPMAP_LINEAR, self._moderngl.LINEAR)
-            # No anisotropic filtering: llvmpipe (the CPU renderer) does it in software, and a textured garment seen
-            # edge-on took 77 s per view at 8x (0.3 s without).
-            texture.anisotropy = 1.0
-            texture.repeat_x = texture.repeat_y = True
-        return vao, vbo, ibo, texture
+        return vao, vbo, ibo
 
 
 def _check_size(size: tuple[int, int], max_size: int, supersample: int = 1, samples: int = 1) -> tuple[int, int]:

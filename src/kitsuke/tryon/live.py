@@ -88,6 +88,7 @@ def run_live(
     *,
     settings: TryOnSettings | None = None,
     constraints=None,  # noqa: ANN001
+    garment=None,  # noqa: ANN001 - a kimono dressed on the default body (default: dressed now)
     snapshots: str | os.PathLike[str] = ".",
     max_seconds: float | None = None,
     paced: bool = True,
@@ -104,7 +105,7 @@ def run_live(
     stop = threading.Event()
     snap_dir = Path(snapshots)
     t0 = time.perf_counter()
-    with _quiet_native_stderr(), TryOn(settings, constraints=constraints) as mirror:
+    with _quiet_native_stderr(), TryOn(settings, garment=garment, constraints=constraints) as mirror:
 
         def hand_on(item: object) -> None:  # waits for the loop to take it, unless the loop has ended
             while not stop.is_set():

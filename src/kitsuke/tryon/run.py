@@ -13,10 +13,12 @@ import os
 import time
 from contextlib import nullcontext
 from dataclasses import dataclass, field
+from itertools import islice
 from pathlib import Path
 
 import numpy as np
 
+from ..errors import InputError
 from .frames import FrameSource, open_frames
 from .mirror import MirrorFrame, TryOn, TryOnSettings
 
@@ -158,11 +160,14 @@ def run_tryon(
     settings: TryOnSettings | None = None,
     constraints=None,  # noqa: ANN001 - a ConstraintTable
     fps: float | None = None,
+    max_frames: int | None = None,
+    garment=None,  # noqa: ANN001 - a kimono dressed on the default body (default: dressed now)
     progress: bool | None = None,
 ) -> TryOnRun:
     """The try-on over every frame of `source` (a video file, an image folder, or a camera index), written to
     `output` (an H.264 mp4; side by side with the uncorrected try-on when `compare`), with an optional JSON
     `report` and `plot` of the legs (PNG, as `kitsuke pose correct --plot`). fps : an image folder's frame rate.
+    max_frames : stop after this many frames.
     InputError for a source that cannot be opened; ComputationError ("simulation") when the kimono diverges:
     then nothing is written."""
     from .._files import write_json_atomic
@@ -173,9 +178,14 @@ def run_tryon(
     run = TryOnRun(_source_info(src))
     width = src.size[0] * (2 if compare else 1)
     t0 = time.perf_counter()
-    with TryOn(settings, constraints=constraints, compare=compare, render=output is not None) as mirror:
+    if max_frames is not None and max_frames < 1:
+        raise InputError(f"max_frames must be at least 1, got {max_frames}")
+    mirror = TryOn(settings, garment=garment, constraints=constraints, compare=compare, render=output is not None)
+    with mirror:
         with nullcontext() if output is None else mp4_writer(output, (width, src.size[1]), src.fps) as send:
-            for frame in bar(iter(src), total=src.total, desc="try-on", enabled=progress or None):
+            frames = islice(src, max_frames)
+            total = src.total if max_frames is None else min(src.total or max_frames, max_frames)
+            for frame in bar(frames, total=total, desc="try-on", enabled=progress or None):
                 out = mirror.step(frame)
                 if send is not None:
                     send(side_by_side(out.raw_image, out.image) if compare else out.image)
@@ -187,7 +197,7 @@ def run_tryon(
         s = run.summary()
         s["warnings"] = run.warnings()
         write_json_atomic(report, s)
-    if plot is not None:
+    if plot is not None and any(f.posed for f in run.frames):  # else warnings() says nobody was found
         plot_legs(run, plot, constraints)
     return run
 
@@ -195,7 +205,6 @@ def run_tryon(
 def plot_legs(run: TryOnRun, path: str | os.PathLike[str], constraints=None) -> Path:  # noqa: ANN001
     """The knee and ankle distances over the run, raw and corrected, against E(θ) (`kitsuke.pose.plot_distances`).
     The correction is recomputed on the filtered poses: the same result as the live one (tested)."""
-    from ..errors import InputError
     from ..pose import PoseSequence, correct_poses, plot_distances
     from ..skeleton import JOINTS
 
