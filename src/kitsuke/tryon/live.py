@@ -15,6 +15,7 @@ import os
 import queue
 import threading
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Protocol
 
@@ -24,6 +25,9 @@ from ..errors import InputError
 from .frames import Latest, open_frames
 from .mirror import TryOn, TryOnSettings
 from .run import TryOnRun, _source_info
+
+#: The live mirror keeps the per-frame measures of this many last frames (counts cover all): flat memory.
+LIVE_FRAMES_KEPT = 2000
 
 _NO_DISPLAY = (
     "no display for the mirror window ({why}); run it on a desktop session, or write a video instead: "
@@ -93,16 +97,19 @@ def run_live(
     max_seconds: float | None = None,
     paced: bool = True,
     on_snapshot=None,  # noqa: ANN001 - a callable taking the snapshot's Path
+    on_frame=None,  # noqa: ANN001 - a callable taking each shown MirrorFrame and the TryOn (measures, recording)
 ) -> TryOnRun:
     """Run the mirror on `source` (a camera index, or a file played at its own rate) until `q`, the end of the
     source or `max_seconds`. Returns the run's measures (frames shown, dropped, latency per frame)."""
     from ..pose._mediapipe import _quiet_native_stderr
 
+    settings = replace(settings or TryOnSettings(), recover=True)  # a mirror carries on: a failed kimono re-dressed
     src = open_frames(source)
     frames = Latest(src, paced=paced)
-    run = TryOnRun(_source_info(src))
+    run = TryOnRun(_source_info(src), keep=LIVE_FRAMES_KEPT)
     observed: queue.Queue = queue.Queue(maxsize=1)
     stop = threading.Event()
+    pace = _Pace()
     snap_dir = Path(snapshots)
     t0 = time.perf_counter()
     with _quiet_native_stderr(), TryOn(settings, garment=garment, constraints=constraints) as mirror:
@@ -116,11 +123,20 @@ def run_live(
                     continue
 
         def observe() -> None:  # the pose thread: the newest frame and its pose, handed to the loop
+            it = iter(frames)
             try:
-                for frame in frames:
-                    if stop.is_set():
+                while not stop.is_set():
+                    # start the pose just in time for the loop's next frame: a pose done early would wait, and
+                    # the frame it shows would be that much older when displayed
+                    delay = pace.next_pose_in()
+                    if delay > 0 and stop.wait(delay):
                         break
-                    hand_on((frame, mirror.observe(frame)))
+                    frame = next(it, None)
+                    if frame is None:
+                        break
+                    seen = mirror.observe(frame)
+                    pace.posed(seen.seconds)
+                    hand_on((frame, seen))
             except BaseException as e:  # noqa: BLE001 - re-raised by the loop below
                 hand_on(e)
             finally:
@@ -137,6 +153,7 @@ def run_live(
                 if isinstance(item, BaseException):
                     raise item
                 frame, seen = item
+                pace.dressing()
                 out = mirror.dress(frame, seen)
                 now = time.perf_counter()
                 shown.append(now)
@@ -144,6 +161,8 @@ def run_live(
                 fps = (len(recent) - 1) / (recent[-1] - recent[0]) if len(recent) > 1 else 0.0
                 view = mirror_view(out.image, fps, mirror.correct)
                 display.show(view)
+                if on_frame is not None:
+                    on_frame(out, mirror)
                 run.add(out, frame.arrived, mirror.registrar.last.residual_px if out.posed and mirror.registrar
                         and mirror.registrar.last is not None else None)  # fmt: skip
                 key = display.key()
@@ -155,6 +174,7 @@ def run_live(
                     path = _snapshot(snap_dir, view)
                     if on_snapshot is not None:
                         on_snapshot(path)
+                pace.dressed()
                 if max_seconds is not None and now - t0 > max_seconds:
                     break
         finally:
@@ -165,6 +185,33 @@ def run_live(
     run.dropped = frames.dropped
     run.skipped, run.ended = src.skipped, src.ended
     return run
+
+
+class _Pace:
+    """When the pose thread should take the next frame: as the loop, which began a frame at `start`, will be done
+    with it `pose_s` later (running means of both stages' times). Shared by two threads: floats are written whole."""
+
+    def __init__(self) -> None:
+        self.pose_s = 0.0
+        self.dress_s = 0.0
+        self.start: float | None = None
+
+    def posed(self, seconds: float) -> None:
+        self.pose_s = seconds if self.pose_s == 0.0 else 0.8 * self.pose_s + 0.2 * seconds
+
+    def dressing(self) -> None:
+        self.start = time.perf_counter()
+
+    def dressed(self) -> None:
+        if self.start is not None:
+            took = time.perf_counter() - self.start
+            self.dress_s = took if self.dress_s == 0.0 else 0.8 * self.dress_s + 0.2 * took
+
+    def next_pose_in(self) -> float:
+        """Seconds to wait before taking the next frame (0: now)."""
+        if self.start is None:
+            return 0.0
+        return self.start + self.dress_s - self.pose_s - time.perf_counter()
 
 
 def _snapshot(folder: Path, rgb: np.ndarray) -> Path:

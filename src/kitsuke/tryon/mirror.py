@@ -9,7 +9,8 @@ with TryOn() as mirror:                          # dresses the default kimono on
 Each stage is a small object with one job (`PoseStage`, `BodyStage`, `KimonoStage`, `Registrar`, `Compositor`);
 `TryOn.step` only passes their results along. A frame without a pose keeps the kimono where it was and fades it out
 over `fade_s`; when the person comes back after it has faded, the kimono is dressed again and blended onto them.
-Two or more people: the largest in the image is dressed (counted in `MirrorFrame.people`).
+Two or more people: the largest in the image is dressed and followed while they stay (counted in
+`MirrorFrame.people`); when they leave, whoever is largest is dressed afresh (`MirrorFrame.switched`).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..cloth import DynamicsParams
+from ..errors import ComputationError
 from ..pose import OneEuroConfig, OneEuroFilter, OnlineCorrector
 from ..skeleton import INDEX
 from .frames import Frame
@@ -44,6 +46,9 @@ class TryOnSettings:
     blend_s : when a person appears, the kimono (dressed on the rest pose) is blended onto their pose over this
         many seconds of simulation, before the frame is shown.
     focal_frames : frames with a pose over which the camera's focal length is fitted (a 60° field of view before).
+    recover : a simulation that fails (diverges, leaves the body) is dressed afresh on the next frame and counted
+        (`MirrorFrame.restarted`), instead of raising ComputationError: what a live mirror wants; a file's run
+        stops and writes nothing.
     filter : the One-Euro filter of the joints.
     dynamics : the cloth solver's settings.
     """
@@ -53,6 +58,7 @@ class TryOnSettings:
     fade_s: float = 1.0
     blend_s: float = 0.5
     focal_frames: int = 15
+    recover: bool = False
     filter: OneEuroConfig = field(default_factory=OneEuroConfig)
     dynamics: DynamicsParams = field(default_factory=DynamicsParams)
 
@@ -66,7 +72,9 @@ class MirrorFrame:
     people : people detected (the largest is dressed). posed : a pose was found and the kimono stepped.
     corrected : the correction rotated a leg. alpha : the kimono's opacity (below 1 while it fades out).
     residual_px : mean registration residual (pixels), NaN when not registered. strain_max : largest edge strain
-    of the kimono. stage_s : wall time per stage, seconds. raw_joints, joints : (J, 3) the filtered and the
+    of the kimono. stage_s : wall time per stage, seconds. restarted : the simulation failed this frame and the
+    kimono is dressed afresh on the next (`TryOnSettings.recover`). switched : the person followed left and
+    another was taken (dressed afresh). raw_joints, joints : (J, 3) the filtered and the
     corrected joints, metres (None without a pose).
     """
 
@@ -82,35 +90,55 @@ class MirrorFrame:
     residual_p95_px: float = float("nan")
     strain_max: float = float("nan")
     stage_s: dict[str, float] = field(default_factory=dict)
+    restarted: bool = False
+    switched: bool = False
     raw_joints: np.ndarray | None = None
     joints: np.ndarray | None = None
 
 
-def _area(image: np.ndarray) -> float:
+#: The person followed from frame to frame is the one whose box overlaps their last box most; below this overlap
+#: (intersection over union) they are gone, and the largest person present is dressed afresh.
+SAME_PERSON_IOU = 0.2
+
+
+def _box(image: np.ndarray) -> np.ndarray:
+    """(4,) x0, y0, x1, y1 pixels around a person's well-seen landmarks (all of them if fewer than 3 are)."""
     seen = image[:, 2] > 0.3
     pts = image[seen if seen.sum() >= 3 else slice(None), :2]
-    return float(np.prod(pts.max(axis=0) - pts.min(axis=0)))
+    return np.r_[pts.min(axis=0), pts.max(axis=0)]
+
+
+def _iou(a: np.ndarray, b: np.ndarray) -> float:
+    w = max(0.0, min(a[2], b[2]) - max(a[0], b[0]))
+    h = max(0.0, min(a[3], b[3]) - max(a[1], b[1]))
+    inter = w * h
+    union = np.prod(a[2:] - a[:2]) + np.prod(b[2:] - b[:2]) - inter
+    return float(inter / union) if union > 0 else 0.0
 
 
 @dataclass(frozen=True)
 class Observation:
     """The pose stage's result for one frame: people found, (J, 3) filtered joints (metres, Y up) and (J, 3) image
-    joints (u, v pixels, visibility) of the largest person, or None; seconds it took."""
+    joints (u, v pixels, visibility) of the person followed, or None; seconds it took. switched : the person
+    followed is gone and another is taken (the kimono is dressed afresh on them)."""
 
     people: int
     joints: np.ndarray | None
     image: np.ndarray | None
     seconds: float
+    switched: bool = False
 
 
 class PoseStage:
-    """MediaPipe on a frame, the largest person kept, joints filtered. Use as a context manager."""
+    """MediaPipe on a frame, one person followed (the largest at first, then whoever overlaps their last place
+    most: `SAME_PERSON_IOU`), joints filtered. Use as a context manager."""
 
     def __init__(self, config: OneEuroConfig) -> None:
         from ..pose import PoseLandmarker
 
         self._landmarker = PoseLandmarker("video", num_poses=2)
         self._filter = OneEuroFilter(config)
+        self._box: np.ndarray | None = None
 
     def __enter__(self) -> PoseStage:
         from ..pose._mediapipe import _quiet_native_stderr
@@ -122,18 +150,32 @@ class PoseStage:
     def __exit__(self, *exc: object) -> None:
         self._landmarker.__exit__(*exc)
 
-    def __call__(self, frame: Frame) -> tuple[int, np.ndarray | None, np.ndarray | None]:
-        """(people found, (J, 3) filtered world joints metres Y up, (J, 3) image joints u, v px and visibility)."""
+    def __call__(self, frame: Frame) -> tuple[int, np.ndarray | None, np.ndarray | None, bool]:
+        """(people found, (J, 3) filtered world joints metres Y up, (J, 3) image joints u, v px and visibility,
+        whether the person followed changed)."""
         from ..pose import image_to_joints, world_to_joints
 
         people = self._landmarker.detect_all(frame.rgb, int(round(frame.time_s * 1000.0)))
         if not people:
-            return 0, None, None
-        world, image = max(people, key=lambda p: _area(p[1]))
-        return len(people), self._filter(world_to_joints(world), frame.time_s), image_to_joints(image)
+            return 0, None, None, False
+        boxes = [_box(image) for _, image in people]
+        switched = False
+        if self._box is not None:
+            overlap = [_iou(self._box, b) for b in boxes]
+            k = int(np.argmax(overlap))
+            if overlap[k] < SAME_PERSON_IOU:  # the one followed left: the largest one present is dressed afresh
+                k, switched = int(np.argmax([np.prod(b[2:] - b[:2]) for b in boxes])), True
+                self._filter.reset()
+        else:
+            k = int(np.argmax([np.prod(b[2:] - b[:2]) for b in boxes]))
+        self._box = boxes[k]
+        world, image = people[k]
+        return len(people), self._filter(world_to_joints(world), frame.time_s), image_to_joints(image), switched
 
     def reset(self) -> None:
+        """Forget the person followed (they have gone)."""
         self._filter.reset()
+        self._box = None
 
 
 class BodyStage:
@@ -154,6 +196,10 @@ class BodyStage:
         self._lowest.append(float(posed[_FEET, 1].min()))
         posed[:, 1] -= self._lift()
         return rot, posed
+
+    def reset(self) -> None:
+        """Forget the floor (another person)."""
+        self._lowest.clear()
 
     def pose(self, joints: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The same for another pose of the same frame (the uncorrected one), on the same floor."""
@@ -342,8 +388,8 @@ class TryOn:
         """The pose stage alone (a live mirror runs it in its own thread, overlapping the previous frame's
         simulation and render)."""
         t0 = time.perf_counter()
-        people, raw, image = self.poses(frame)
-        return Observation(people, raw, image, time.perf_counter() - t0)
+        people, raw, image, switched = self.poses(frame)
+        return Observation(people, raw, image, time.perf_counter() - t0, switched)
 
     def dress(self, frame: Frame, seen: Observation) -> MirrorFrame:
         """Everything after the pose: correction, body, simulation, registration, render."""
@@ -354,14 +400,15 @@ class TryOn:
             self.registrar = Registrar((frame.rgb.shape[1], frame.rgb.shape[0]), s.focal_frames)
         dt = self._dt(frame.time_s)
         raw, image = seen.joints, seen.image
+        if seen.switched:  # another person: their own kimono, blended on from the rest pose
+            self._forget_person()
+            out.switched = True
         if raw is None:
             self.corrector(None)
             since = None if self._last_pose_t is None else frame.time_s - self._last_pose_t
             out.alpha = 0.0 if since is None else max(0.0, 1.0 - since / s.fade_s)
             if since is not None and since >= s.fade_s:  # faded out: whoever comes next is dressed afresh
-                self.kimono.stop()
-                if self.raw_kimono is not None:
-                    self.raw_kimono.stop()
+                self._forget_person()
                 self.poses.reset()
                 self._last_pose_t = None
         else:
@@ -377,10 +424,16 @@ class TryOn:
                 for stage, (r, j) in ((self.kimono, (rot, joints)), (self.raw_kimono, (raw_rot, raw_posed))):
                     if stage is None:
                         continue
-                    if stage.started:
-                        stage.step(r, j, dt)
-                    else:
-                        stage.start(r, j, dt)
+                    try:
+                        if stage.started:
+                            stage.step(r, j, dt)
+                        else:
+                            stage.start(r, j, dt)
+                    except ComputationError:
+                        if not s.recover:
+                            raise
+                        stage.stop()
+                        out.restarted = True
             with timer("register"):
                 reg = self.registrar(raw_posed, image)
             if reg is not None:
@@ -390,13 +443,22 @@ class TryOn:
             out.alpha = 1.0
             out.raw_joints, out.joints = raw, fixed
             self._last_pose_t = frame.time_s
-        if self.kimono.started:
+        if self.kimono.started and not out.restarted:
             out.strain_max = self.kimono.strain_max()
         with timer("render"):
             out.image = self._draw(frame, self.kimono, out.alpha)
             if self.raw_kimono is not None:
                 out.raw_image = self._draw(frame, self.raw_kimono, out.alpha)
         return out
+
+    def _forget_person(self) -> None:
+        self.kimono.stop()
+        if self.raw_kimono is not None:
+            self.raw_kimono.stop()
+        self.corrector(None)  # K' restarts
+        self.posing.reset()
+        if self.registrar is not None:
+            self.registrar.last = None  # the camera's pose is fitted afresh on them
 
     def _draw(self, frame: Frame, stage: KimonoStage, alpha: float) -> np.ndarray | None:
         if self.compositor is None:

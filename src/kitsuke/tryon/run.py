@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import os
 import time
+from collections import deque
 from contextlib import nullcontext
-from dataclasses import dataclass, field
 from itertools import islice
 from pathlib import Path
 
@@ -26,26 +26,41 @@ from .mirror import MirrorFrame, TryOn, TryOnSettings
 REGISTRATION_TARGET_PX = 10.0
 
 
-@dataclass
 class TryOnRun:
-    """What a try-on run measured. source : the source's name, size, fps. frames : one `MirrorFrame` per frame
-    (images dropped). wall_s : wall time of the whole run. skipped : frames that did not decode. dropped : frames
-    a live run dropped to keep up. ended : why the source ended early, or None. latency_s : per shown frame, from
-    its arrival to its output, seconds."""
+    """What a try-on run measured.
 
-    source: dict
-    frames: list[MirrorFrame] = field(default_factory=list)
-    wall_s: float = 0.0
-    skipped: int = 0
-    dropped: int = 0
-    ended: str | None = None
-    latency_s: list[float] = field(default_factory=list)
-    residuals: list[np.ndarray] = field(default_factory=list)
+    source : the source's name, size, fps. keep : how many of the last frames keep their per-frame measures
+    (None: all; a live mirror keeps a bounded number, so that a run of hours stays flat in memory). Counts and
+    the mean residual cover every frame. frames : `MirrorFrame`s kept (images dropped). latency_s : per kept
+    frame, from its arrival to its output, seconds. wall_s : wall time of the run. skipped : frames that did not
+    decode. dropped : frames a live run dropped to keep up. ended : why the source ended early, or None.
+    """
+
+    def __init__(self, source: dict, keep: int | None = None) -> None:
+        self.source = source
+        self.frames: deque[MirrorFrame] = deque(maxlen=keep)
+        self.latency_s: deque[float] = deque(maxlen=keep)
+        self.residuals: deque[np.ndarray] = deque(maxlen=keep)
+        self.counts = {"frames": 0, "posed": 0, "several": 0, "corrected": 0, "restarted": 0, "switched": 0}
+        self._residual_sum, self._residual_n = 0.0, 0
+        self.wall_s = 0.0
+        self.skipped = self.dropped = 0
+        self.ended: str | None = None
 
     def add(self, frame: MirrorFrame, arrived: float, residuals: np.ndarray | None) -> None:
         self.latency_s.append(time.perf_counter() - arrived)
+        c = self.counts
+        c["frames"] += 1
+        c["posed"] += frame.posed
+        c["several"] += frame.people > 1
+        c["corrected"] += frame.corrected
+        c["restarted"] += frame.restarted
+        c["switched"] += frame.switched
         if residuals is not None:
-            self.residuals.append(residuals[np.isfinite(residuals)])
+            r = residuals[np.isfinite(residuals)]
+            self.residuals.append(r)
+            self._residual_sum += float(r.sum())
+            self._residual_n += len(r)
         frame.image = frame.raw_image = None  # the video holds them; the report needs the numbers only
         self.frames.append(frame)
 
@@ -64,7 +79,13 @@ class TryOnRun:
         if s["frames_without_pose"]:
             out.append(f"{s['frames_without_pose']} frames without a person (the kimono held, then faded)")
         if s["frames_with_several_people"]:
-            out.append(f"{s['frames_with_several_people']} frames with several people: the largest was dressed")
+            out.append(
+                f"{s['frames_with_several_people']} frames with several people: one was followed (the largest at first)"
+            )
+        if s["person_switches"]:
+            out.append(f"the person followed left {s['person_switches']} times: another was dressed afresh")
+        if s["kimono_restarts"]:
+            out.append(f"the kimono's simulation failed {s['kimono_restarts']} times and was dressed afresh")
         if self.skipped:
             out.append(f"{self.skipped} frames did not decode and were skipped")
         if self.ended:
@@ -72,9 +93,10 @@ class TryOnRun:
         return out
 
     def summary(self) -> dict:
-        fr = self.frames
-        posed = [f for f in fr if f.posed]
-        res = np.concatenate(self.residuals) if self.residuals else np.zeros(0)
+        fr = list(self.frames)
+        c = self.counts
+        res = np.concatenate(list(self.residuals)) if self.residuals else np.zeros(0)
+        mean = self._residual_sum / self._residual_n if self._residual_n else None
         w, h = self.source["size"]
         scale = 640.0 / max(w, h) if max(w, h) > 0 else 1.0  # pixels of the same view at 640x480
         stages = sorted({k for f in fr for k in f.stage_s})
@@ -83,18 +105,20 @@ class TryOnRun:
         strains = [f.strain_max for f in fr if np.isfinite(f.strain_max)]
         return {
             "source": self.source,
-            "frames": len(fr),
-            "frames_with_pose": len(posed),
-            "frames_without_pose": len(fr) - len(posed),
-            "frames_with_several_people": sum(f.people > 1 for f in fr),
-            "frames_corrected": sum(f.corrected for f in fr),
+            "frames": c["frames"],
+            "frames_with_pose": c["posed"],
+            "frames_without_pose": c["frames"] - c["posed"],
+            "frames_with_several_people": c["several"],
+            "frames_corrected": c["corrected"],
+            "kimono_restarts": c["restarted"],
+            "person_switches": c["switched"],
             "frames_skipped": self.skipped,
             "frames_dropped": self.dropped,
             "ended_early": self.ended,
             "registration": {
-                "mean_px": round(float(res.mean()), 2) if len(res) else None,
+                "mean_px": round(mean, 2) if mean is not None else None,
                 "p95_px": round(float(np.percentile(res, 95)), 2) if len(res) else None,
-                "scaled_mean_px": round(float(res.mean()) * scale, 2) if len(res) else None,
+                "scaled_mean_px": round(mean * scale, 2) if mean is not None else None,
                 "scale_to_640x480": round(scale, 4),
                 "target_mean_px": REGISTRATION_TARGET_PX,
             },
@@ -103,12 +127,13 @@ class TryOnRun:
                 "worst": round(float(np.max(strains)), 4) if strains else None,
             },
             "speed": {
-                "fps": round(len(fr) / self.wall_s, 2) if self.wall_s > 0 else None,
+                "fps": round(c["frames"] / self.wall_s, 2) if self.wall_s > 0 else None,
                 "latency_ms_median": round(float(np.median(lat)) * 1e3, 1),
                 "latency_ms_p95": round(float(np.percentile(lat, 95)) * 1e3, 1),
                 "stage_ms_mean": {k: round(float(np.mean(v)) * 1e3, 2) for k, v in per_stage.items()},
             },
             "wall_s": round(self.wall_s, 2),
+            "per_frame_kept": len(fr),
             "per_frame": [_frame_row(f) for f in fr],
         }
 
@@ -127,6 +152,7 @@ def _frame_row(f: MirrorFrame) -> dict:
         "residual_px": r(f.residual_px),
         "residual_p95_px": r(f.residual_p95_px),
         "strain_max": r(f.strain_max, 4),
+        "restarted": f.restarted,
         "stage_ms": {k: round(v * 1e3, 2) for k, v in f.stage_s.items()},
     }
 
@@ -185,14 +211,19 @@ def run_tryon(
         with nullcontext() if output is None else mp4_writer(output, (width, src.size[1]), src.fps) as send:
             frames = islice(src, max_frames)
             total = src.total if max_frames is None else min(src.total or max_frames, max_frames)
-            for frame in bar(frames, total=total, desc="try-on", enabled=progress or None):
-                out = mirror.step(frame)
-                if send is not None:
-                    send(side_by_side(out.raw_image, out.image) if compare else out.image)
-                reg = mirror.registrar.last if out.posed and np.isfinite(out.residual_px) else None
-                run.add(out, frame.arrived, reg.residual_px if reg is not None else None)
+            try:
+                for frame in bar(frames, total=total, desc="try-on", enabled=progress or None):
+                    out = mirror.step(frame)
+                    if send is not None:
+                        send(side_by_side(out.raw_image, out.image) if compare else out.image)
+                    reg = mirror.registrar.last if out.posed and np.isfinite(out.residual_px) else None
+                    run.add(out, frame.arrived, reg.residual_px if reg is not None else None)
+            except KeyboardInterrupt:
+                if not src.live:
+                    raise
+                run.ended = "stopped with Ctrl-C"  # a camera records until stopped: what was recorded is kept
         run.wall_s = time.perf_counter() - t0
-    run.skipped, run.ended = src.skipped, src.ended
+    run.skipped, run.ended = src.skipped, run.ended or src.ended
     if report is not None:
         s = run.summary()
         s["warnings"] = run.warnings()
