@@ -29,6 +29,7 @@ GROUPS: dict[str, tuple[str, str]] = {
     "render": ("render", "render meshes to PNG"),
     "pose": ("pose", "extract poses from video/images/camera/BVH, correct them for a kimono, animate the body"),
     "kimono": ("kimono", "simulate the kimono on a body moved by poses; calibrate its posture limits E"),
+    "app": ("app", "the browser app: draw strokes on the pattern and the body, wrap, save"),
     "tryon": ("tryon", "the kimono try-on mirror: video, images or camera in, the person wearing a kimono out"),
     "batch": ("batch", "run many dress jobs or kimono calibrations from a manifest, locally or on Ray"),
 }
@@ -48,6 +49,7 @@ examples:
   kitsuke pose animate walk.bvh -o walk.glb        # the default body, skinned and animated
   kitsuke kimono simulate --poses walk.bvh -o walk_kimono.glb --video walk_kimono.mp4   # the kimono moving
   kitsuke kimono calibrate -o limits.json --plot limits.png                          # E(θ) by simulation
+  kitsuke app                                    # the browser app on http://127.0.0.1:8080
   kitsuke tryon clip.mp4 -o clip_kimono.mp4 --compare   # the try-on mirror on a video (--camera 0 --window: live)
   kitsuke batch dress jobs.csv -o out/            # one dress per manifest row, on every core (or --address)
 

@@ -1,0 +1,154 @@
+"""One user's dressing in the app: a body, a pattern, the stroke pairs drawn so far, and the dressed garment.
+
+No user interface here: the app's views call these methods and draw what they hold. Pattern strokes are kept in
+the coordinates of the pattern's file (as stroke files and `wrap` take them); the board shows them on the pieces.
+
+session = DressingSession(default_body(), default_kimono())
+session.draw_pattern_stroke("migoro_right", points_cm)   # a stroke on a piece (file coordinates, cm)
+pair = session.draw_body_stroke(points_m)                # its partner on the body: pair 1
+session.undo(); session.redo()
+session.strokes()                                        # Strokes, for wrap or a file
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..dressing import BodyStroke, PatternStroke, StrokePair, Strokes, in_piece_frame
+from ..errors import InputError
+from ..geometry.surface import Surface
+
+#: Colours of stroke pairs, by number (the paper numbers and colours each pair); sRGB 0-255.
+PAIR_COLORS = (
+    (230, 25, 75), (60, 180, 75), (0, 130, 200), (245, 130, 48), (145, 30, 180),
+    (70, 200, 200), (240, 50, 230), (150, 110, 40), (0, 128, 128), (128, 0, 0),
+)  # fmt: skip
+
+
+def pair_color(pair_id: int) -> tuple[int, int, int]:
+    return PAIR_COLORS[(pair_id - 1) % len(PAIR_COLORS)]
+
+
+@dataclass
+class _State:
+    pairs: list[StrokePair] = field(default_factory=list)
+    pending: PatternStroke | None = None
+
+
+class DressingSession:
+    """The state of one dressing: body and pattern (fixed), stroke pairs (drawn, with undo and redo), and the
+    garment last dressed. body : a `kitsuke.body.Body`; pattern : a `kitsuke.pattern.Pattern`."""
+
+    def __init__(self, body, pattern, strokes: Strokes | None = None) -> None:  # noqa: ANN001
+        self.body = body
+        self.pattern = pattern
+        self.surface = Surface(body.mesh)
+        self._state = _State()
+        self._undo: list[_State] = []
+        self._redo: list[_State] = []
+        self.garment = None
+        if strokes is not None:
+            self.load_strokes(strokes)
+
+    # -- the drawing ----------------------------------------------------------------------------------------
+    @property
+    def pairs(self) -> list[StrokePair]:
+        return list(self._state.pairs)
+
+    @property
+    def pending(self) -> PatternStroke | None:
+        """A pattern stroke waiting for its body stroke (the next stroke drawn on the body)."""
+        return self._state.pending
+
+    def next_id(self) -> int:
+        return max((p.id for p in self._state.pairs), default=0) + 1
+
+    def _change(self, pairs: list[StrokePair], pending: PatternStroke | None) -> None:
+        self._undo.append(self._state)
+        self._redo.clear()
+        self._state = _State(pairs, pending)
+
+    def draw_pattern_stroke(self, piece: str, points_cm: np.ndarray) -> PatternStroke:
+        """A stroke on a piece, in the pattern file's coordinates (cm); it waits for its body stroke. Drawing
+        another before that replaces it. InputError: unknown piece, fewer than 2 points, a zero-length stroke."""
+        if piece not in self.pattern.piece_names:
+            raise InputError(f"no piece named {piece!r} in the pattern")
+        stroke = PatternStroke(piece, np.asarray(points_cm, dtype=np.float64))
+        self._change(list(self._state.pairs), stroke)
+        return stroke
+
+    def draw_body_stroke(self, points_m: np.ndarray) -> StrokePair:
+        """The body stroke of the waiting pattern stroke: (n, 3) points on (or near) the body, metres, put on its
+        surface. Returns the new pair. InputError when no pattern stroke waits."""
+        pending = self._state.pending
+        if pending is None:
+            raise InputError("draw the stroke on the pattern first, then its partner on the body")
+        body = BodyStroke(points=np.asarray(points_m, dtype=np.float64))
+        body.surface = self.surface.closest(body.points)
+        pair = StrokePair(self.next_id(), pending, body)
+        self._change([*self._state.pairs, pair], None)
+        return pair
+
+    def delete(self, pair_id: int) -> None:
+        pairs = [p for p in self._state.pairs if p.id != pair_id]
+        if len(pairs) == len(self._state.pairs):
+            raise InputError(f"no stroke pair {pair_id}")
+        self._change(pairs, self._state.pending)
+
+    def clear(self) -> None:
+        self._change([], None)
+
+    def undo(self) -> bool:
+        if not self._undo:
+            return False
+        self._redo.append(self._state)
+        self._state = self._undo.pop()
+        return True
+
+    def redo(self) -> bool:
+        if not self._redo:
+            return False
+        self._undo.append(self._state)
+        self._state = self._redo.pop()
+        return True
+
+    # -- strokes in and out ---------------------------------------------------------------------------------
+    def strokes(self) -> Strokes:
+        """The pairs drawn, as Strokes (pattern points in the file's coordinates)."""
+        return Strokes(list(self._state.pairs), "body", {"drawn_in": "kitsuke app"})
+
+    def load_strokes(self, strokes: Strokes) -> None:
+        """Replace the pairs by those of a strokes file (checked against the pattern; body strokes put on the
+        body)."""
+        from ..dressing import check_strokes
+
+        if strokes.target != "body":
+            raise InputError("these strokes re-wrap a garment; load strokes drawn on the body", strokes.source)
+        check_strokes(strokes, self.pattern)
+        pairs = []
+        for p in strokes.pairs:
+            body = p.body
+            if not body.resolved:
+                body = BodyStroke(points=body.points, rays=body.rays, hit=body.hit)
+                body.surface = (
+                    self.surface.closest(body.points)
+                    if body.points is not None
+                    else self.surface.cast(body.rays[:, :3], body.rays[:, 3:], hit=body.hit)
+                )
+            pairs.append(StrokePair(p.id, p.pattern, body))
+        self._change(pairs, None)
+
+    def suggest(self) -> int:
+        """Replace the pairs by `kitsuke.dressing.suggest_strokes` (the pattern's placement carried to the body);
+        returns how many pairs."""
+        from ..dressing import suggest_strokes
+
+        self.load_strokes(suggest_strokes(self.body, self.pattern, surface=self.surface))
+        return len(self._state.pairs)
+
+    def pattern_points_on_piece(self, pair: StrokePair) -> np.ndarray:
+        """(n, 2) the pair's pattern stroke in its piece's own coordinates, cm (what the board shows)."""
+        one = Strokes([pair], "body")
+        return in_piece_frame(one, self.pattern).pairs[0].pattern.points

@@ -1,0 +1,109 @@
+"""The app in a real browser: Debian's chromium driven by playwright, headless, software WebGL. Skipped where
+either is missing (CI installs both)."""
+
+from __future__ import annotations
+
+import shutil
+import time
+
+import numpy as np
+import pytest
+
+FLAGS = [
+    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+]  # fmt: skip
+VIEWPORT = {"width": 1280, "height": 800}
+
+
+def _browser_or_skip():
+    chromium = shutil.which("chromium")
+    if chromium is None:
+        pytest.skip("Debian's chromium is not installed (apt-get install chromium)")
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        pytest.skip("playwright is not installed (pip install playwright)")
+    return chromium, sync_playwright
+
+
+@pytest.fixture(scope="module")
+def browser():
+    chromium, sync_playwright = _browser_or_skip()
+    with sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=chromium, args=FLAGS)
+        yield b
+        b.close()
+
+
+class AppPage:
+    """A started app, one browser tab on it, and helpers to point at scene positions."""
+
+    def __init__(self, app, page) -> None:
+        self.app = app
+        self.page = page
+        self.requests: list[str] = []
+        page.on("request", lambda r: self.requests.append(r.url))
+
+    @property
+    def view(self):
+        return next(iter(self.app.views.values()))
+
+    def wait_connected(self, timeout: float = 30.0) -> None:
+        t0 = time.monotonic()
+        while not self.app.views:
+            if time.monotonic() - t0 > timeout:
+                raise TimeoutError("the page never connected to the app")
+            time.sleep(0.1)
+        self.page.wait_for_timeout(1500)  # the first frames, and the camera's first report
+        close = self.page.get_by_role("button", name="Close")
+        if close.count():  # viser's "software WebGL" notice swallows clicks under it
+            close.first.click()
+
+    def screen(self, points: np.ndarray) -> np.ndarray:
+        """(n, 2) page pixels of world points (n, 3), from the tab's own camera."""
+        cam = self.view.client.camera
+        eye, at = np.asarray(cam.position), np.asarray(cam.look_at)
+        up = np.asarray(cam.up_direction)
+        f = (at - eye) / np.linalg.norm(at - eye)
+        r = np.cross(f, up)
+        r /= np.linalg.norm(r)
+        u = np.cross(r, f)
+        rel = np.atleast_2d(points) - eye
+        x, y, z = rel @ r, rel @ u, rel @ f
+        t = np.tan(cam.fov / 2)
+        w, h = VIEWPORT["width"], VIEWPORT["height"]
+        ndc_x = x / (z * t * w / h)
+        ndc_y = y / (z * t)
+        return np.c_[(ndc_x + 1) / 2 * w, (1 - ndc_y) / 2 * h]
+
+    def drag(self, points: np.ndarray, steps_per_segment: int = 4) -> None:
+        """Press at the first world point, move through the others, release (a stroke drawn by hand)."""
+        px = self.screen(points)
+        m = self.page.mouse
+        m.move(*px[0])
+        m.down()
+        for a, b in zip(px[:-1], px[1:], strict=True):
+            for s in range(1, steps_per_segment + 1):
+                p = a + (b - a) * s / steps_per_segment
+                m.move(float(p[0]), float(p[1]))
+                self.page.wait_for_timeout(60)  # viser reports drags every ~50 ms
+        m.up()
+        self.page.wait_for_timeout(400)
+
+
+@pytest.fixture
+def app_page(browser, request):
+    """The app on a free port with a fresh tab; `request.param` (optional) are App arguments."""
+    from kitsuke.app import App, free_port
+
+    kwargs = getattr(request, "param", {}) or {}
+    app = App(**kwargs)
+    url = app.start("127.0.0.1", free_port())
+    page = browser.new_page(viewport=VIEWPORT, accept_downloads=True)
+    ap = AppPage(app, page)
+    page.goto(url)
+    ap.wait_connected()
+    yield ap
+    page.close()
+    app.stop()

@@ -1,0 +1,198 @@
+"""The browser app: its session logic, and the app driven with the mouse in a real (headless) Chromium."""
+
+from __future__ import annotations
+
+import io
+import json
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from kitsuke.app import BoardLayout, DressingSession
+from kitsuke.body import default_body
+from kitsuke.dressing import load_packaged_strokes, strokes_to_json
+from kitsuke.errors import InputError
+from kitsuke.geometry.surface import Surface
+from kitsuke.pattern import default_kimono
+
+
+@pytest.fixture(scope="module")
+def body():
+    return default_body()
+
+
+@pytest.fixture(scope="module")
+def kimono():
+    return default_kimono()
+
+
+def _front_of_body(body, x: float, ys: np.ndarray) -> np.ndarray:
+    """Points on the front of the body at x, heights ys (metres): rays cast from in front."""
+    surface = Surface(body.mesh)
+    origins = np.c_[np.full(len(ys), x), ys, np.full(len(ys), 2.0)]
+    hits = surface.cast(origins, np.tile([0.0, 0.0, -1.0], (len(ys), 1)), hit="first")
+    assert hits.hit.all()
+    return hits.points
+
+
+# ------------------------------------------------------------------------------------------- without a browser
+
+
+def test_board_round_trip_and_flipped_pieces(kimono):
+    board = BoardLayout.of(kimono)
+    pts = np.array([[3.0, 10.0], [20.0, 100.0]])
+    for name in kimono.piece_names:
+        np.testing.assert_allclose(board.to_piece(name, board.to_board(name, pts)), pts, atol=1e-9)
+    flipped = kimono.copy()
+    flipped.pieces[0].flipped = True
+    fb = BoardLayout.of(flipped)
+    name = flipped.pieces[0].name
+    a, b = fb.to_board(name, pts), board.to_board(name, pts)
+    assert np.allclose(a[:, 1], b[:, 1]) and not np.allclose(a[:, 0], b[:, 0])  # mirrored left-right
+    np.testing.assert_allclose(fb.to_piece(name, a), pts, atol=1e-9)
+    # pieces do not overlap on the board, and the board stays right of the body
+    boxes = [np.r_[p.origin, p.origin + [p.width_cm * board.scale, 0]] for p in board.places.values()]
+    assert min(b[0] for b in boxes) > 0.5
+
+
+def test_session_pairs_undo_redo(body, kimono):
+    s = DressingSession(body, kimono)
+    with pytest.raises(InputError, match="pattern first"):
+        s.draw_body_stroke(_front_of_body(body, 0.05, np.array([1.1, 1.2])))
+    s.draw_pattern_stroke("migoro_right", np.array([[15.0, 100.0], [15.0, 150.0]]))
+    assert s.pending is not None and s.next_id() == 1
+    pair = s.draw_body_stroke(_front_of_body(body, 0.05, np.linspace(1.05, 1.3, 6)) + [0, 0, 0.01])
+    assert pair.id == 1 and s.pending is None and len(s.pairs) == 1
+    # the body stroke lies on the skin, not where the pointer was (1 cm off it)
+    d = np.linalg.norm(pair.body.surface_points - _front_of_body(body, 0.05, np.linspace(1.05, 1.3, 6)), axis=1)
+    assert d.max() < 0.01
+    s.undo()
+    assert s.pairs == [] and s.pending is not None
+    s.undo()
+    assert s.pending is None
+    s.redo()
+    s.redo()
+    assert [p.id for p in s.pairs] == [1]
+    with pytest.raises(InputError):
+        s.draw_pattern_stroke("no_such_piece", np.array([[0, 0], [1, 1.0]]))
+    s.delete(1)
+    assert not s.pairs
+    with pytest.raises(InputError):
+        s.delete(7)
+
+
+def test_session_loads_and_checks_strokes(body, kimono):
+    s = DressingSession(body, kimono, load_packaged_strokes("kimono_default"))
+    assert len(s.pairs) == 10 and all(p.body.resolved for p in s.pairs)
+    text = json.loads(strokes_to_json(s.strokes()))
+    assert len(text["pairs"]) == 10
+    bad = load_packaged_strokes("kimono_default")
+    bad.pairs[0].pattern.piece = "sleeve_of_another_garment"
+    with pytest.raises(InputError):
+        s.load_strokes(bad)
+    assert len(s.pairs) == 10  # a refused file changes nothing
+
+
+# ------------------------------------------------------------------------------------------------ in a browser
+
+
+def test_draw_a_stroke_pair_with_the_mouse(app_page):
+    """Press-drag on a pattern piece, then on the body: one numbered pair, each stroke where it was drawn."""
+    view = app_page.view
+    piece_pts = np.array([[15.0, y] for y in np.linspace(110, 170, 5)])
+    on_board = view.board.to_board("migoro_right", piece_pts)
+    app_page.drag(on_board)
+    s = view.session
+    assert s.pending is not None and s.pending.piece == "migoro_right"
+    got = view.session.pattern.file_to_piece("migoro_right", s.pending.points)
+    # within 1.5 cm of the drawn line, along most of it
+    assert np.abs(got[:, 0] - 15.0).max() < 1.5
+    assert got[:, 1].min() < 125 and got[:, 1].max() > 155
+    body_pts = _front_of_body(view.session.body, 0.06, np.linspace(1.0, 1.3, 5))
+    app_page.drag(body_pts)
+    assert len(s.pairs) == 1 and s.pending is None
+    pair = s.pairs[0]
+    assert pair.id == 1
+    near = Surface(view.session.body.mesh).closest(pair.body.surface_points)
+    assert np.abs(near.distance).max() < 1e-3  # on the skin
+    assert np.abs(pair.body.surface_points[:, 0] - 0.06).max() < 0.03
+    assert pair.body.surface_points[:, 1].min() < 1.06 and pair.body.surface_points[:, 1].max() > 1.24
+    assert "1 stroke pair" in app_page.page.content()
+    app_page.page.get_by_role("button", name="Undo").click()
+    app_page.page.wait_for_timeout(500)
+    assert len(s.pairs) == 0
+    assert all(u.startswith(("http://127.0.0.1", "ws://127.0.0.1", "data:", "blob:")) for u in app_page.requests)
+
+
+@pytest.mark.parametrize("app_page", [{"strokes": load_packaged_strokes("kimono_default")}], indirect=True)
+def test_wrap_in_the_browser_then_save_the_garment(app_page, tmp_path):
+    """Wrap from the browser: the garment appears on the body (server scene and pixels), and the saved OBJ reads
+    back as the garment."""
+    from kitsuke.dressing.export import read_garment_obj
+
+    page = app_page.page
+    view = app_page.view
+    before = np.asarray(Image.open(io.BytesIO(page.screenshot())))
+    page.get_by_role("button", name="Wrap", exact=True).click()
+    for _ in range(240):
+        if view.session.garment is not None and not view.busy:
+            break
+        page.wait_for_timeout(500)
+    g = view.session.garment
+    assert g is not None, "the wrap did not finish in 2 minutes"
+    assert getattr(view, "garment_handle", None) is not None
+    page.wait_for_timeout(1500)
+    after = np.asarray(Image.open(io.BytesIO(page.screenshot())))
+    # where the body's trunk is on screen, the picture changed (the garment covers it)
+    cx, cy = app_page.screen(np.array([[0.0, 1.1, 0.15]]))[0].astype(int)
+    patch = (slice(cy - 30, cy + 30), slice(cx - 30, cx + 30))
+    assert np.abs(after[patch].astype(int) - before[patch].astype(int)).mean() > 20
+    page.screenshot(path=str(tmp_path / "dressed.png"))
+    downloads = []
+    page.on("download", lambda d: downloads.append(d))
+    page.get_by_role("button", name="Save garment (GLB, OBJ, report)").click()
+    for _ in range(100):
+        if len(downloads) == 3:
+            break
+        page.wait_for_timeout(200)
+    names = {d.suggested_filename for d in downloads}
+    paths = {d.suggested_filename: d.path() for d in downloads}
+    assert names == {"garment.glb", "garment.obj", "garment_report.json"}
+    obj = tmp_path / "garment.obj"
+    obj.write_bytes(open(paths["garment.obj"], "rb").read())
+    back = read_garment_obj(obj)
+    assert len(back.positions) == len(g.positions)
+    np.testing.assert_allclose(back.positions, g.positions, atol=1e-5)
+
+
+def test_bad_upload_says_why(app_page, tmp_path):
+    bad = tmp_path / "broken.json"
+    bad.write_text('{"pieces": "not a list"')
+    inputs = app_page.page.locator("input[type=file]")
+    assert inputs.count() == 3
+    inputs.nth(1).set_input_files(str(bad))  # "Open pattern"
+    app_page.page.get_by_text("Not a pattern this app can use").wait_for(timeout=15000)
+    assert "broken.json" in app_page.page.content()
+    assert app_page.view.session.pattern.name == "kimono"  # unchanged
+
+
+def test_each_tab_is_its_own_session(app_page, browser):
+    other = browser.new_page()
+    other.goto(app_page.app.url)
+    for _ in range(100):
+        if len(app_page.app.views) == 2:
+            break
+        other.wait_for_timeout(100)
+    views = list(app_page.app.views.values())
+    assert len(views) == 2 and views[0].session is not views[1].session
+    views[0].session.draw_pattern_stroke("eri", np.array([[3.0, 20.0], [3.0, 60.0]]))
+    assert views[1].session.pending is None
+    other.close()
+
+
+def test_cli_app_refuses_bad_arguments(run_cli, tmp_path):
+    r = run_cli("app", "--port", "70000", "--no-browser")
+    assert r.code == 2 and "--port" in r.err
+    r = run_cli("app", "--pattern", str(tmp_path / "none.json"), "--no-browser")
+    assert r.code == 2 and "none.json" in r.err
