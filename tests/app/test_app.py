@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import io
 import json
+import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,6 +14,7 @@ from PIL import Image
 from kitsuke.app import BoardLayout, DressingSession
 from kitsuke.body import default_body
 from kitsuke.dressing import load_packaged_strokes, strokes_to_json
+from kitsuke.dressing.options import DressOptions
 from kitsuke.errors import InputError
 from kitsuke.geometry.surface import Surface
 from kitsuke.pattern import default_kimono
@@ -125,7 +128,11 @@ def test_draw_a_stroke_pair_with_the_mouse(app_page):
     assert all(u.startswith(("http://127.0.0.1", "ws://127.0.0.1", "data:", "blob:")) for u in app_page.requests)
 
 
-@pytest.mark.parametrize("app_page", [{"strokes": load_packaged_strokes("kimono_default")}], indirect=True)
+@pytest.mark.parametrize(
+    "app_page",
+    [{"strokes": load_packaged_strokes("kimono_default"), "options": DressOptions(edge_length=2.5)}],
+    indirect=True,
+)
 def test_wrap_in_the_browser_then_save_the_garment(app_page, tmp_path):
     """Wrap from the browser: the garment appears on the body (server scene and pixels), and the saved OBJ reads
     back as the garment."""
@@ -148,7 +155,10 @@ def test_wrap_in_the_browser_then_save_the_garment(app_page, tmp_path):
     cx, cy = app_page.screen(np.array([[0.0, 1.1, 0.15]]))[0].astype(int)
     patch = (slice(cy - 30, cy + 30), slice(cx - 30, cx + 30))
     assert np.abs(after[patch].astype(int) - before[patch].astype(int)).mean() > 20
-    page.screenshot(path=str(tmp_path / "dressed.png"))
+    # the README's picture of the app (KITSUKE_APP_SCREENSHOTS=docs pytest tests/app -k wrap rebuilds it)
+    shots = Path(os.environ.get("KITSUKE_APP_SCREENSHOTS", tmp_path))
+    page.screenshot(path=str(shots / "app_kimono_dressed.png"))
+    _drag_and_pin(app_page)
     downloads = []
     page.on("download", lambda d: downloads.append(d))
     page.get_by_role("button", name="Save garment (GLB, OBJ, report)").click()
@@ -162,8 +172,59 @@ def test_wrap_in_the_browser_then_save_the_garment(app_page, tmp_path):
     obj = tmp_path / "garment.obj"
     obj.write_bytes(open(paths["garment.obj"], "rb").read())
     back = read_garment_obj(obj)
-    assert len(back.positions) == len(g.positions)
-    np.testing.assert_allclose(back.positions, g.positions, atol=1e-5)
+    now = view.dragging.positions
+    assert len(back.positions) == len(now)
+    np.testing.assert_allclose(back.positions, now, atol=1e-5)  # the garment as dragged
+
+
+def _front_of(mesh_vertices: np.ndarray, faces: np.ndarray, x: float, y: float) -> np.ndarray:
+    from kitsuke.geometry import TriMesh
+
+    hit = Surface(TriMesh(mesh_vertices, faces)).cast(np.array([[x, y, 2.0]]), np.array([[0, 0, -1.0]]))
+    assert hit.hit.all()
+    return hit.points[0]
+
+
+def _wait_idle(app_page) -> None:
+    for _ in range(900):  # a release settles the cloth: seconds on a 5,000-vertex garment
+        if not app_page.view.dragger.busy and not app_page.view.dragger._ops:
+            return
+        app_page.page.wait_for_timeout(100)
+    raise TimeoutError("the drag did not finish")
+
+
+def _drag_and_pin(app_page) -> None:
+    """Drag the kimono's front up by its hem; pin a point and drag again: the pin holds."""
+    view, page = app_page.view, app_page.page
+    d = view.dragging
+    before = d.positions.copy()
+    start = _front_of(d.positions, d.model.faces, 0.12, 0.55)
+    path = np.array([start + [0, dy, 0] for dy in (0.0, 0.04, 0.08, 0.12)])
+    app_page.drag(path)
+    _wait_idle(app_page)
+    moved = np.linalg.norm(d.positions[: len(before)] - before, axis=1) if d.n_vertices == len(before) else None
+    if moved is not None:
+        assert moved.max() > 0.03, "the garment did not follow the drag"
+    grabbed_near = np.argmin(np.linalg.norm(d.positions - (start + [0, 0.12, 0]), axis=1))
+    assert d.positions[grabbed_near, 1] > start[1] + 0.04  # cloth rose with the pointer
+    assert len(view.dragger.update_s) >= 2
+    # pin: the pin mode, a click on the garment's left front; then a drag on the right front
+    page.get_by_text("Click to pin / unpin").click()
+    page.wait_for_timeout(300)
+    pin_at = _front_of(d.positions, d.model.faces, -0.12, 0.9)
+    px = app_page.screen(pin_at[None])[0]
+    page.mouse.click(float(px[0]), float(px[1]))
+    page.wait_for_timeout(800)
+    assert d.pinned.sum() == 1
+    pinned = np.flatnonzero(d.pinned)[0]
+    held = d.positions[pinned].copy()
+    start = _front_of(d.positions, d.model.faces, 0.1, 0.7)
+    app_page.drag(np.array([start + [dx, 0, 0] for dx in (0.0, -0.03, -0.06)]))
+    _wait_idle(app_page)
+    assert np.linalg.norm(d.positions[pinned] - held) < 2e-3  # the pin held
+    page.get_by_role("button", name="Undo drag").click()
+    page.wait_for_timeout(500)
+    assert d.pinned.sum() == 1
 
 
 def test_bad_upload_says_why(app_page, tmp_path):

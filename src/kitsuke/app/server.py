@@ -207,16 +207,32 @@ class ClientView:
             self.flip_choice = gui.add_dropdown("Piece", pieces, initial_value=pieces[0])
             gui.add_button("Turn piece over").on_click(lambda _: self._flip(self.flip_choice.value))
         with gui.add_folder("Wrap"):
+            self.edge = gui.add_number(
+                "Mesh edge (cm)", self.app.options.edge_length, min=0.5, max=5.0, step=0.5,
+                hint="the garment's triangle size: larger is faster to wrap and to drag, with coarser folds",
+            )  # fmt: skip
             self.wrap_button = gui.add_button("Wrap", color="blue", icon="shirt")
             self.wrap_button.on_click(lambda _: self._start_wrap())
             self.cancel_button = gui.add_button("Cancel wrap", disabled=True)
             self.cancel_button.on_click(lambda _: self.cancel.set())
+        with gui.add_folder("Drag the garment"):
+            self.pin_mode = gui.add_checkbox("Click to pin / unpin", False)
+            gui.add_button("Unpin all").on_click(lambda _: self._unpin_all())
+            gui.add_button("Undo drag").on_click(lambda _: self._drag_history(undo=True))
+            gui.add_button("Redo drag").on_click(lambda _: self._drag_history(undo=False))
+            self.drag_rate = gui.add_markdown("Wrap first; then press and drag on the garment.")
         with gui.add_folder("Files"):
             gui.add_upload_button("Open body (OBJ, GLB, PLY)").on_upload(self._upload_body)
             gui.add_upload_button("Open pattern (JSON, SVG)").on_upload(self._upload_pattern)
             gui.add_upload_button("Open strokes (JSON)").on_upload(self._upload_strokes)
             gui.add_button("Save strokes").on_click(lambda _: self._download_strokes())
             gui.add_button("Save garment (GLB, OBJ, report)").on_click(lambda _: self._download_garment())
+
+    def _unpin_all(self) -> None:
+        if getattr(self, "dragging", None) is not None and not self.dragger.busy:
+            self.drag_undo.append(self.dragging.snapshot())
+            self.dragging.unpin(all=True)
+            self._show_pins()
 
     def _show_seams(self, on: bool) -> None:
         if getattr(self, "seam_handle", None) is not None:
@@ -265,8 +281,9 @@ class ClientView:
         threading.Thread(target=self._wrap, args=(strokes,), daemon=True, name="kitsuke-app-wrap").start()
 
     def _wrap(self, strokes) -> None:  # noqa: ANN001
+        from dataclasses import replace
+
         from ..dressing import target_misses
-        from ..dressing.options import DressOptions
 
         s = self.session
         note = self.client.add_notification("Wrapping", "0 s", loading=True, with_close_button=False)
@@ -279,7 +296,7 @@ class ClientView:
 
         threading.Thread(target=tick, daemon=True).start()
         try:
-            params = DressOptions().wrap_params(s.body, s.pattern)
+            params = replace(self.app.options, edge_length=float(self.edge.value)).wrap_params(s.body, s.pattern)
             garment = self.app.worker.wrap(s.body, s.pattern, strokes, params, cancel=self.cancel)
         except Cancelled:
             self._wrap_ended(note, done, "Wrap cancelled", "Nothing changed.", "yellow")
@@ -289,15 +306,100 @@ class ClientView:
             self._wrap_ended(note, done, "The wrap failed", reason, "red")
             return
         s.garment = garment
-        self.garment_handle = self.client.scene.add_mesh_simple(
-            "/garment", garment.positions.astype(np.float32), garment.faces.astype(np.uint32),
-            color=GARMENT_COLOR, side="double",
-        )  # fmt: skip
+        self._start_drag(garment)
         misses = target_misses(garment)
         verdict = "all quality targets met" if not misses else "missed: " + "; ".join(misses)
         summary = f"Dressed: {garment.n_vertices} vertices, {garment.timings.get('wrap', 0.0):.1f} s; {verdict}."
         self._wrap_ended(note, done, "Dressed", summary, "green" if not misses else "yellow")
         self._status(summary)
+
+    # -- drag and pins ----------------------------------------------------------------------------------------
+    def _start_drag(self, garment) -> None:  # noqa: ANN001 - a DressedGarment
+        from ..dressing import DragSession
+
+        self.dragging = DragSession(self.session.body, garment)
+        self.drag_undo: list = []
+        self.drag_redo: list = []
+        self.dragger = Dragger(self)
+        self._show_garment()
+
+    def _show_garment(self) -> None:
+        """(Re)build the garment's scene node from the drag session (a release may refine its mesh)."""
+        d = self.dragging
+        self.garment_handle = self.client.scene.add_mesh_simple(
+            "/garment", d.positions.astype(np.float32), d.model.faces.astype(np.uint32),
+            color=GARMENT_COLOR, side="double",
+        )  # fmt: skip
+        self.garment_handle.on_drag()(self._on_garment_drag)
+        self.garment_handle.on_click()(self._on_garment_click)
+        self._shown_vertices = d.n_vertices
+        self._show_pins()
+
+    def _show_pins(self) -> None:
+        d = self.dragging
+        pts = d.positions[d.pinned]
+        if len(pts):
+            self.client.scene.add_point_cloud(
+                "/pins", pts.astype(np.float32), (255, 200, 0), point_size=0.02, point_shape="circle"
+            )
+        else:
+            self.client.scene.remove_by_name("/pins")
+
+    def push_positions(self) -> None:
+        """Send the garment's vertices (only them) to the browser."""
+        d = self.dragging
+        if d.n_vertices != self._shown_vertices:
+            self._show_garment()
+        else:
+            self.garment_handle.vertices = d.positions.astype(np.float32)
+
+    async def _on_garment_drag(self, event) -> None:  # noqa: ANN001
+        if event.phase == "start":
+            self.dragger.submit("grab", np.asarray(event.start_position, dtype=np.float64))
+        elif event.phase == "update":
+            self.dragger.submit("move", self._body_target(event))
+        else:
+            self.dragger.submit("release", None)
+
+    def _body_target(self, event) -> np.ndarray:  # noqa: ANN001
+        """Where the pointer is on the body (its ray's first hit), or the body point nearest the pointer's place
+        on the camera-facing plane when the ray misses the body."""
+        eye, direction = self._ray(event)
+        hit = self.session.surface.cast(eye[None], direction[None], hit="first")
+        if hit.hit.all():
+            return hit.points[0]
+        return self.session.surface.closest(np.asarray(event.end_position, dtype=np.float64)[None]).points[0]
+
+    async def _on_garment_click(self, event) -> None:  # noqa: ANN001
+        if not self.pin_mode.value or self.dragger.busy:
+            return
+        from ..geometry import TriMesh
+        from ..geometry.surface import Surface
+
+        d = self.dragging
+        cloth = Surface(TriMesh(d.positions, d.model.faces))
+        hit = cloth.cast(np.asarray(event.ray_origin)[None], np.asarray(event.ray_direction)[None], hit="first")
+        if not hit.hit.all():
+            return
+        v = int(d.model.faces[hit.faces[0]][np.argmax(hit.barycentric[0])])
+        self.drag_undo.append(d.snapshot())
+        self.drag_redo.clear()
+        if d.pinned[v]:
+            d.unpin(vertices=[v])
+        else:
+            d.pin(vertices=[v])
+        self._show_pins()
+
+    def _drag_history(self, undo: bool) -> None:
+        if getattr(self, "dragging", None) is None or self.dragger.busy:
+            return
+        src, dst = (self.drag_undo, self.drag_redo) if undo else (self.drag_redo, self.drag_undo)
+        if not src:
+            return
+        dst.append(self.dragging.snapshot())
+        self.dragging.restore(src.pop())
+        self.push_positions()
+        self._show_pins()
 
     def _wrap_ended(self, note, done: threading.Event, title: str, body: str, color: str) -> None:  # noqa: ANN001
         done.set()
@@ -379,27 +481,111 @@ class ClientView:
         )
 
     def _download_garment(self) -> None:
-        from ..dressing.export import write_garment_outputs
+        """The garment as it is now (dragged, pinned) with its quality report."""
+        from .._files import write_json_atomic
+        from ..dressing.export import write_garment_glb, write_garment_obj
 
-        g = self.session.garment
-        if g is None:
+        if getattr(self, "dragging", None) is None:
             self.notify("Nothing dressed yet", "Wrap first, then save the garment.", "yellow")
             return
+        garment, body = self.dragging.garment(), self.session.body.mesh
         with tempfile.TemporaryDirectory() as d:
             paths = [Path(d) / n for n in ("garment.glb", "garment.obj", "garment_report.json")]
-            write_garment_outputs(g, self.session.body.mesh, *paths, None)
+            write_garment_glb(garment, paths[0], body=body)
+            write_garment_obj(garment, paths[1])
+            write_json_atomic(paths[2], self.dragging.report().to_dict())
             for p in paths:
                 self.client.send_file_download(p.name, p.read_bytes(), save_immediately=True)
+
+
+class Dragger:
+    """Runs a tab's drag in its own thread, newest pointer position first: a move waiting when a newer one comes
+    is dropped, so the garment follows the pointer instead of replaying its path late. Grab and release are
+    never dropped. Measures the updates per second it manages."""
+
+    def __init__(self, view: ClientView) -> None:
+        self.view = view
+        self._ops: list[tuple[str, np.ndarray | None]] = []
+        self._cv = threading.Condition()
+        self.busy = False
+        self.update_s: list[float] = []
+        threading.Thread(target=self._run, daemon=True, name="kitsuke-app-drag").start()
+
+    def submit(self, op: str, point: np.ndarray | None) -> None:
+        with self._cv:
+            if op == "move" and self._ops and self._ops[-1][0] == "move":
+                self._ops[-1] = (op, point)
+            else:
+                self._ops.append((op, point))
+            self._cv.notify()
+
+    def _run(self) -> None:
+        while True:
+            with self._cv:
+                while not self._ops:
+                    self._cv.wait()
+                op, point = self._ops.pop(0)
+            try:
+                self._do(op, point)
+            except InputError as e:  # a grab on a pinned point, a drag off the garment: said, not fatal
+                self.view.notify("Drag", e.message, "yellow")
+                self._abandon()
+            except ComputationError as e:  # the drag could not be solved: back to before it
+                self.view.notify("The drag failed", f"{e.stage}: {e.message}", "red")
+                self._abandon()
+
+    def _abandon(self) -> None:
+        v = self.view
+        if v.dragging.grabbed is not None and v.drag_undo:
+            v.dragging.restore(v.drag_undo.pop())
+            v.dragging.grabbed = None
+            v.push_positions()
+        with self._cv:
+            self._ops = [op for op in self._ops if op[0] == "grab"]  # the rest belonged to the failed drag
+        self.busy = False
+
+    def _do(self, op: str, point: np.ndarray | None) -> None:
+        v, d = self.view, self.view.dragging
+        if op == "grab":
+            v.drag_undo.append(d.snapshot())
+            v.drag_redo.clear()
+            d.grab(point)
+            self.busy = True
+            self._t_grab = time.perf_counter()
+            self.update_s.clear()
+        elif op == "move" and d.grabbed is not None:
+            t0 = time.perf_counter()
+            d.move_to(point)
+            v.push_positions()
+            self._t_last = time.perf_counter()
+            self.update_s.append(self._t_last - t0)
+        elif op == "release" and d.grabbed is not None:
+            note = v.client.add_notification("Settling", "the cloth after the drag", loading=True)
+            try:
+                d.release()
+            finally:
+                note.remove()
+            v.push_positions()
+            self.busy = False
+            n = len(self.update_s)
+            if n:
+                rate = n / max(self._t_last - self._t_grab, 1e-9)  # while dragging (the release apart)
+                v.drag_rate.content = (
+                    f"Last drag: {n} updates, {1e3 * float(np.median(self.update_s)):.0f} ms each, "
+                    f"{rate:.1f} per second."
+                )
 
 
 class App:
     """The app: a viser server, one `ClientView` per browser tab, one wrap worker shared by the tabs (their
     wraps run in turn)."""
 
-    def __init__(self, body=None, pattern=None, strokes=None) -> None:  # noqa: ANN001
+    def __init__(self, body=None, pattern=None, strokes=None, options=None) -> None:  # noqa: ANN001
         from ..body import default_body
+        from ..dressing.options import DressOptions
         from ..pattern import default_kimono
 
+        self.options = options or DressOptions()  # the wrap's defaults, as `kitsuke dress` has them
         self.body = default_body() if body is None else body
         self.pattern = default_kimono() if pattern is None else pattern
         self.strokes = strokes
