@@ -121,8 +121,8 @@ def test_draw_a_stroke_pair_with_the_mouse(app_page):
     assert np.abs(near.distance).max() < 1e-3  # on the skin
     assert np.abs(pair.body.surface_points[:, 0] - 0.06).max() < 0.03
     assert pair.body.surface_points[:, 1].min() < 1.06 and pair.body.surface_points[:, 1].max() > 1.24
-    assert "1 stroke pair" in app_page.page.content()
-    app_page.page.get_by_role("button", name="Undo").click()
+    app_page.page.get_by_text("1 stroke pair(s)").wait_for(timeout=15000)
+    app_page.page.get_by_role("button", name="Undo", exact=True).click()
     app_page.page.wait_for_timeout(500)
     assert len(s.pairs) == 0
     assert all(u.startswith(("http://127.0.0.1", "ws://127.0.0.1", "data:", "blob:")) for u in app_page.requests)
@@ -257,3 +257,23 @@ def test_cli_app_refuses_bad_arguments(run_cli, tmp_path):
     assert r.code == 2 and "--port" in r.err
     r = run_cli("app", "--pattern", str(tmp_path / "none.json"), "--no-browser")
     assert r.code == 2 and "none.json" in r.err
+
+
+def test_open_a_garmentcode_shirt_and_suggest_strokes(app_page):
+    """A GarmentCode pattern uploaded from tests/data replaces the kimono on the board; strokes are one click."""
+    shirt = Path(__file__).parent.parent / "data" / "pattern" / "shirt_mean_specification.json"
+    page = app_page.page
+    page.locator("input[type=file]").nth(1).set_input_files(str(shirt))
+    for _ in range(100):
+        if "right_ftorso" in app_page.view.board.places:
+            break
+        page.wait_for_timeout(100)
+    view = app_page.view
+    assert set(view.board.places) == set(view.session.pattern.piece_names) and len(view.board.places) == 8
+    page.get_by_role("button", name="Suggest strokes").click()
+    for _ in range(100):
+        if view.session.pairs:
+            break
+        page.wait_for_timeout(100)
+    assert len(view.session.pairs) == 8
+    page.get_by_text("8 stroke pair(s)").wait_for(timeout=15000)  # the panel says so

@@ -18,7 +18,7 @@ can reach the port can use the app). Each browser tab is its own session; the ta
 
 examples:
   kitsuke app                                             # the default body and kimono
-  kitsuke app --pattern tests/data/pattern/shirt_spec.json --port 8081
+  kitsuke app --pattern tests/data/pattern/shirt_mean_specification.json --port 8081
   kitsuke app --strokes out/kimono_strokes.json --no-browser
 """
 
