@@ -277,3 +277,36 @@ def test_open_a_garmentcode_shirt_and_suggest_strokes(app_page):
         page.wait_for_timeout(100)
     assert len(view.session.pairs) == 8
     page.get_by_text("8 stroke pair(s)").wait_for(timeout=15000)  # the panel says so
+
+
+def test_session_laser_stroke_lands_front_and_back(body, kimono):
+    s = DressingSession(body, kimono)
+    rays = np.array([[x, 1.2, 2.0, 0.0, 0.0, -1.0] for x in np.linspace(-0.08, 0.08, 5)])
+    s.draw_pattern_stroke("migoro_right", np.array([[15.0, 100.0], [15.0, 140.0]]))
+    with pytest.raises(InputError, match="two pattern strokes"):
+        s.draw_laser_stroke(rays)
+    s.draw_pattern_stroke("migoro_left", np.array([[15.0, 180.0], [15.0, 220.0]]))
+    front, back = s.draw_laser_stroke(rays)
+    assert (front.id, back.id) == (1, 2)
+    assert front.pattern.piece == "migoro_right" and back.pattern.piece == "migoro_left"
+    assert (front.body.surface_points[:, 2] > 0.05).all() and (back.body.surface_points[:, 2] < 0.05).all()
+    assert s.waiting == ()
+    with pytest.raises(InputError, match="cross the body"):
+        s.draw_pattern_stroke("eri", np.array([[3.0, 20.0], [3.0, 60.0]]))
+        s.draw_pattern_stroke("eri", np.array([[3.0, 80.0], [3.0, 120.0]]))
+        s.draw_laser_stroke(np.array([[2.0, 1.2, 2.0, 0, 0, -1.0], [2.1, 1.2, 2.0, 0, 0, -1.0]]))
+
+
+def test_laser_stroke_in_the_browser(app_page):
+    """Two pattern strokes, the laser ticked, one drag across the body: two pairs, on the front and on the back."""
+    view, page = app_page.view, app_page.page
+    app_page.drag(view.board.to_board("migoro_right", np.array([[15.0, y] for y in (110.0, 130.0, 150.0)])))
+    app_page.drag(view.board.to_board("migoro_left", np.array([[15.0, y] for y in (190.0, 210.0, 230.0)])))
+    page.get_by_text("Laser (front and back)").click()
+    page.wait_for_timeout(300)
+    across = _front_of_body(view.session.body, 0.0, np.array([1.2]))[0]
+    app_page.drag(np.array([across + [dx, 0, 0] for dx in (-0.08, -0.03, 0.02, 0.07)]))
+    pairs = view.session.pairs
+    assert len(pairs) == 2
+    assert (pairs[0].body.surface_points[:, 2] > 0.05).all()  # entered at the front
+    assert (pairs[1].body.surface_points[:, 2] < 0.05).all()  # left at the back

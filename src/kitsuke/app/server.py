@@ -121,9 +121,10 @@ class ClientView:
             self._stroke_handles.append(
                 scene.add_label(f"/strokes/{pair.id}/label", str(pair.id), position=tuple(on_body[0]))
             )
-        if s.pending is not None:
-            pts = self.board.to_board(s.pending.piece, self._piece_points(s.pending)) + [0, 0, 0.006]
-            self._stroke_handles.append(self._polyline("/strokes/pending", pts, (40, 40, 40)))
+        shown = s.waiting if self.laser.value else s.waiting[-1:]
+        for k, stroke in enumerate(shown):
+            pts = self.board.to_board(stroke.piece, self._piece_points(stroke)) + [0, 0, 0.006]
+            self._stroke_handles.append(self._polyline(f"/strokes/pending{k}", pts, (40, 40, 40)))
         self._status()
 
     def _piece_points(self, stroke) -> np.ndarray:  # noqa: ANN001 - a PatternStroke in file coordinates
@@ -157,6 +158,8 @@ class ClientView:
         return handler
 
     async def _on_body_drag(self, event) -> None:  # noqa: ANN001
+        if self.laser.value:
+            return self._laser_drag(event)
         if event.phase == "start":
             self.drawing = _Drawing(None, [np.asarray(event.start_position, dtype=np.float64)])
             return
@@ -169,6 +172,24 @@ class ClientView:
         if event.phase == "end":
             drawn, self.drawing = self.drawing, None
             self._finish_body_stroke(drawn)
+
+    def _laser_drag(self, event) -> None:  # noqa: ANN001
+        """A laser stroke: the pointer's rays, kept whole (origin and direction) for both of their hits."""
+        eye = np.asarray(event.client.camera.position, dtype=np.float64)
+        if event.phase == "start":
+            self.drawing = _Drawing(None, [np.r_[eye, np.asarray(event.start_position) - eye]])
+            return
+        if self.drawing is None or self.drawing.piece is not None:
+            return
+        self.drawing.points.append(np.r_[self._ray(event)])
+        if event.phase == "end":
+            rays, self.drawing = np.array(self.drawing.points), None
+            if len(rays) >= 2:
+                try:
+                    self.session.draw_laser_stroke(rays)
+                except InputError as e:
+                    self.notify("Laser stroke not kept", e.message, "yellow")
+            self._redraw_strokes()
 
     def _finish_pattern_stroke(self, drawn: _Drawing) -> None:
         pts = np.array(drawn.points)
@@ -200,6 +221,11 @@ class ClientView:
             gui.add_button("Redo", icon="arrow-forward-up").on_click(lambda _: self._edit(self.session.redo))
             gui.add_button("Suggest strokes").on_click(lambda _: self._edit(self.session.suggest))
             gui.add_button("Clear strokes").on_click(lambda _: self._edit(self.session.clear))
+            self.laser = gui.add_checkbox(
+                "Laser (front and back)", False,
+                hint="one stroke across the body lands on its front and its back, for the last two pattern strokes",
+            )  # fmt: skip
+            self.laser.on_update(lambda _: self._redraw_strokes())
         with gui.add_folder("View"):
             seams = gui.add_checkbox("Show seams", True)
             seams.on_update(lambda _: self._show_seams(seams.value))
@@ -248,7 +274,13 @@ class ClientView:
     def _status(self, extra: str = "") -> None:
         s = self.session
         lines = [f"**{s.pattern.name}** on the body: {len(s.pairs)} stroke pair(s)."]
-        if s.pending is not None:
+        if self.laser.value:
+            if len(s.waiting) < 2:
+                lines.append("Laser: draw a stroke on a front piece, then one on a back piece.")
+            else:
+                lines.append(f"Laser: now one stroke across the body for *{s.waiting[0].piece}* (front) and "
+                             f"*{s.waiting[1].piece}* (back).")  # fmt: skip
+        elif s.pending is not None:
             lines.append(f"Stroke {s.next_id()} drawn on *{s.pending.piece}*: now draw its partner on the body.")
         else:
             lines.append("Draw a stroke on a pattern piece, then its partner on the body.")

@@ -34,7 +34,7 @@ def pair_color(pair_id: int) -> tuple[int, int, int]:
 @dataclass
 class _State:
     pairs: list[StrokePair] = field(default_factory=list)
-    pending: PatternStroke | None = None
+    waiting: tuple[PatternStroke, ...] = ()  # the last pattern strokes drawn without a partner (at most 2)
 
 
 class DressingSession:
@@ -59,46 +59,74 @@ class DressingSession:
 
     @property
     def pending(self) -> PatternStroke | None:
-        """A pattern stroke waiting for its body stroke (the next stroke drawn on the body)."""
-        return self._state.pending
+        """The pattern stroke waiting for its body stroke (the next stroke drawn on the body)."""
+        return self._state.waiting[-1] if self._state.waiting else None
+
+    @property
+    def waiting(self) -> tuple[PatternStroke, ...]:
+        """The last two pattern strokes drawn without a partner: a laser stroke pairs with both."""
+        return self._state.waiting
 
     def next_id(self) -> int:
         return max((p.id for p in self._state.pairs), default=0) + 1
 
-    def _change(self, pairs: list[StrokePair], pending: PatternStroke | None) -> None:
+    def _change(self, pairs: list[StrokePair], waiting: tuple[PatternStroke, ...]) -> None:
         self._undo.append(self._state)
         self._redo.clear()
-        self._state = _State(pairs, pending)
+        self._state = _State(pairs, waiting)
 
     def draw_pattern_stroke(self, piece: str, points_cm: np.ndarray) -> PatternStroke:
-        """A stroke on a piece, in the pattern file's coordinates (cm); it waits for its body stroke. Drawing
-        another before that replaces it. InputError: unknown piece, fewer than 2 points, a zero-length stroke."""
+        """A stroke on a piece, in the pattern file's coordinates (cm); it waits for its body stroke (a body
+        stroke pairs with the last one drawn, a laser stroke with the last two). InputError: unknown piece, fewer
+        than 2 points, a zero-length stroke."""
         if piece not in self.pattern.piece_names:
             raise InputError(f"no piece named {piece!r} in the pattern")
         stroke = PatternStroke(piece, np.asarray(points_cm, dtype=np.float64))
-        self._change(list(self._state.pairs), stroke)
+        self._change(list(self._state.pairs), (*self._state.waiting[-1:], stroke))
         return stroke
 
     def draw_body_stroke(self, points_m: np.ndarray) -> StrokePair:
         """The body stroke of the waiting pattern stroke: (n, 3) points on (or near) the body, metres, put on its
         surface. Returns the new pair. InputError when no pattern stroke waits."""
-        pending = self._state.pending
+        pending = self.pending
         if pending is None:
             raise InputError("draw the stroke on the pattern first, then its partner on the body")
         body = BodyStroke(points=np.asarray(points_m, dtype=np.float64))
         body.surface = self.surface.closest(body.points)
         pair = StrokePair(self.next_id(), pending, body)
-        self._change([*self._state.pairs, pair], None)
+        self._change([*self._state.pairs, pair], ())
         return pair
+
+    def draw_laser_stroke(self, rays: np.ndarray) -> tuple[StrokePair, StrokePair]:
+        """One stroke across the body for the last two pattern strokes (the paper's laser): (n, 6) rays, origin
+        then direction, metres. Where they first enter the body pairs with the first of the two (a front piece),
+        where they last leave it with the second (a back piece). InputError: fewer than two pattern strokes
+        waiting, or rays that miss the body."""
+        if len(self._state.waiting) < 2:
+            raise InputError("a laser stroke needs two pattern strokes first: the front piece's, then the back's")
+        rays = np.asarray(rays, dtype=np.float64)
+        strokes = []
+        for hit in ("first", "last"):
+            b = BodyStroke(rays=rays, hit=hit)
+            sp = self.surface.cast(rays[:, :3], rays[:, 3:], hit=hit)
+            if not sp.hit.all():
+                raise InputError("the laser stroke must cross the body from start to end")
+            b.surface = sp
+            strokes.append(b)
+        front, back = self._state.waiting
+        n = self.next_id()
+        pairs = (StrokePair(n, front, strokes[0]), StrokePair(n + 1, back, strokes[1]))
+        self._change([*self._state.pairs, *pairs], ())
+        return pairs
 
     def delete(self, pair_id: int) -> None:
         pairs = [p for p in self._state.pairs if p.id != pair_id]
         if len(pairs) == len(self._state.pairs):
             raise InputError(f"no stroke pair {pair_id}")
-        self._change(pairs, self._state.pending)
+        self._change(pairs, self._state.waiting)
 
     def clear(self) -> None:
-        self._change([], None)
+        self._change([], ())
 
     def undo(self) -> bool:
         if not self._undo:
@@ -138,7 +166,7 @@ class DressingSession:
                     else self.surface.cast(body.rays[:, :3], body.rays[:, 3:], hit=body.hit)
                 )
             pairs.append(StrokePair(p.id, p.pattern, body))
-        self._change(pairs, None)
+        self._change(pairs, ())
 
     def suggest(self) -> int:
         """Replace the pairs by `kitsuke.dressing.suggest_strokes` (the pattern's placement carried to the body);

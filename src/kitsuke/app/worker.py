@@ -21,7 +21,11 @@ class Cancelled(Exception):
 
 def _serve(conn) -> None:  # noqa: ANN001 - a multiprocessing Connection
     """The child: take (body, pattern, strokes, params) jobs, answer ("ok", garment) or the error."""
+    import signal
+
     from ..dressing import wrap
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C in the terminal is for the app, which ends this process
 
     while True:
         try:
