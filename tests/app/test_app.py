@@ -130,7 +130,7 @@ def test_draw_a_stroke_pair_with_the_mouse(app_page):
 
 @pytest.mark.parametrize(
     "app_page",
-    [{"strokes": load_packaged_strokes("kimono_default"), "options": DressOptions(edge_length=2.5)}],
+    [{"strokes": load_packaged_strokes("kimono_default"), "options": DressOptions(edge_length=3.0, no_polish=True)}],
     indirect=True,
 )
 def test_wrap_in_the_browser_then_save_the_garment(app_page, tmp_path):
@@ -159,6 +159,7 @@ def test_wrap_in_the_browser_then_save_the_garment(app_page, tmp_path):
     shots = Path(os.environ.get("KITSUKE_APP_SCREENSHOTS", tmp_path))
     page.screenshot(path=str(shots / "app_kimono_dressed.png"))
     _drag_and_pin(app_page)
+    _rewrap(app_page)
     downloads = []
     page.on("download", lambda d: downloads.append(d))
     page.get_by_role("button", name="Save garment (GLB, OBJ, report)").click()
@@ -191,6 +192,33 @@ def _wait_idle(app_page) -> None:
             return
         app_page.page.wait_for_timeout(100)
     raise TimeoutError("the drag did not finish")
+
+
+def _rewrap(app_page) -> None:
+    """Re-wrap: a stroke on the right front panel, its partner drawn on the garment 4 cm to the side; the cloth
+    along the pattern stroke moves toward it, the pin still holds."""
+    view, page = app_page.view, app_page.page
+    d = view.dragging
+    pinned = np.flatnonzero(d.pinned)
+    held = d.positions[pinned].copy()
+    before = d.positions.copy()
+    page.get_by_text("Click to pin / unpin").click()  # off again
+    page.get_by_text("Draw on the garment (re-wrap)").click()
+    page.wait_for_timeout(300)
+    app_page.drag(view.board.to_board("migoro_right", np.array([[15.0, y] for y in (120.0, 135.0, 150.0)])))
+    top = _front_of(d.positions, d.model.faces, -0.02, 1.0)
+    app_page.drag(np.array([top + [0, dy, 0] for dy in (0.0, -0.05, -0.1)]))
+    assert len(view.session.garment_pairs) == 1
+    page.get_by_role("button", name="Re-wrap", exact=True).click()
+    for _ in range(240):
+        page.wait_for_timeout(500)
+        if not view.busy and view.dragging is not d:
+            break
+    assert view.dragging is not d, "the re-wrap did not finish in 2 minutes"
+    new = view.dragging.positions
+    assert np.linalg.norm(new[: len(before)] - before, axis=1).max() > 0.01  # the cloth moved
+    assert np.linalg.norm(new[pinned] - held, axis=1).max() < 3e-3  # the pin held
+    assert view.session.garment_pairs == []  # they were for the garment before
 
 
 def _drag_and_pin(app_page) -> None:
@@ -241,7 +269,7 @@ def test_bad_upload_says_why(app_page, tmp_path):
 def test_each_tab_is_its_own_session(app_page, browser):
     other = browser.new_page()
     other.goto(app_page.app.url)
-    for _ in range(100):
+    for _ in range(300):
         if len(app_page.app.views) == 2:
             break
         other.wait_for_timeout(100)
@@ -277,6 +305,25 @@ def test_open_a_garmentcode_shirt_and_suggest_strokes(app_page):
         page.wait_for_timeout(100)
     assert len(view.session.pairs) == 8
     page.get_by_text("8 stroke pair(s)").wait_for(timeout=15000)  # the panel says so
+
+
+def test_session_garment_strokes_for_a_rewrap(body, kimono):
+    from kitsuke.geometry import TriMesh
+
+    s = DressingSession(body, kimono)
+    cloth = Surface(TriMesh(body.mesh.vertices * [1.05, 1.0, 1.05], body.mesh.faces))  # a stand-in garment
+    with pytest.raises(InputError, match="pattern first"):
+        s.draw_garment_stroke(np.array([[0.0, 1.2, 0.2], [0.0, 1.1, 0.2]]), cloth)
+    s.draw_pattern_stroke("migoro_right", np.array([[15.0, 100.0], [15.0, 140.0]]))
+    pair = s.draw_garment_stroke(_front_of_body(body, 0.05, np.linspace(1.0, 1.2, 4)) * [1.05, 1, 1.05], cloth)
+    assert pair.id == 1 and len(s.garment_pairs) == 1 and s.pairs == []
+    st = s.garment_strokes()
+    assert st.target == "garment" and len(st) == 1
+    s.undo()
+    assert s.garment_pairs == []
+    s.redo()
+    s.garment_changed()
+    assert s.garment_pairs == []
 
 
 def test_session_laser_stroke_lands_front_and_back(body, kimono):

@@ -35,6 +35,7 @@ def pair_color(pair_id: int) -> tuple[int, int, int]:
 class _State:
     pairs: list[StrokePair] = field(default_factory=list)
     waiting: tuple[PatternStroke, ...] = ()  # the last pattern strokes drawn without a partner (at most 2)
+    garment_pairs: list[StrokePair] = field(default_factory=list)  # re-wrap strokes, drawn on the garment
 
 
 class DressingSession:
@@ -70,10 +71,13 @@ class DressingSession:
     def next_id(self) -> int:
         return max((p.id for p in self._state.pairs), default=0) + 1
 
-    def _change(self, pairs: list[StrokePair], waiting: tuple[PatternStroke, ...]) -> None:
+    def _change(
+        self, pairs: list[StrokePair], waiting: tuple[PatternStroke, ...], garment_pairs: list | None = None
+    ) -> None:
         self._undo.append(self._state)
         self._redo.clear()
-        self._state = _State(pairs, waiting)
+        kept = self._state.garment_pairs if garment_pairs is None else garment_pairs
+        self._state = _State(pairs, waiting, list(kept))
 
     def draw_pattern_stroke(self, piece: str, points_cm: np.ndarray) -> PatternStroke:
         """A stroke on a piece, in the pattern file's coordinates (cm); it waits for its body stroke (a body
@@ -118,6 +122,34 @@ class DressingSession:
         pairs = (StrokePair(n, front, strokes[0]), StrokePair(n + 1, back, strokes[1]))
         self._change([*self._state.pairs, *pairs], ())
         return pairs
+
+    @property
+    def garment_pairs(self) -> list[StrokePair]:
+        """Re-wrap stroke pairs: pattern strokes (in their piece's own coordinates) and strokes drawn on the
+        dressed garment."""
+        return list(self._state.garment_pairs)
+
+    def draw_garment_stroke(self, points_m: np.ndarray, garment_surface: Surface) -> StrokePair:
+        """A re-wrap stroke: the waiting pattern stroke goes where (n, 3) points drawn on the dressed garment
+        (`garment_surface`, the garment as it is now) say. InputError when no pattern stroke waits."""
+        pending = self.pending
+        if pending is None:
+            raise InputError("draw the stroke on the pattern first, then where it should go on the garment")
+        body = BodyStroke(points=np.asarray(points_m, dtype=np.float64))
+        body.surface = garment_surface.closest(body.points)
+        piece_points = self.pattern.file_to_piece(pending.piece, pending.points)  # a re-wrap names piece coordinates
+        ids = [p.id for p in self._state.garment_pairs]
+        pair = StrokePair(max(ids, default=0) + 1, PatternStroke(pending.piece, piece_points), body)
+        self._change(list(self._state.pairs), (), [*self._state.garment_pairs, pair])
+        return pair
+
+    def garment_strokes(self) -> Strokes:
+        """The re-wrap pairs as Strokes with target "garment" (what `kitsuke.dressing.rewrap.rewrap` takes)."""
+        return Strokes(list(self._state.garment_pairs), "garment", {"drawn_in": "kitsuke app"})
+
+    def garment_changed(self) -> None:
+        """A re-wrap or a new wrap: the re-wrap strokes were for the garment before it."""
+        self._change(list(self._state.pairs), self._state.waiting, [])
 
     def delete(self, pair_id: int) -> None:
         pairs = [p for p in self._state.pairs if p.id != pair_id]

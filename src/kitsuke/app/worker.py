@@ -20,10 +20,12 @@ class Cancelled(Exception):
 
 
 def _serve(conn) -> None:  # noqa: ANN001 - a multiprocessing Connection
-    """The child: take (body, pattern, strokes, params) jobs, answer ("ok", garment) or the error."""
+    """The child: take ("wrap", body, pattern, strokes, params) or ("rewrap", body, garment, strokes, pins) jobs,
+    answer ("ok", result) or the error."""
     import signal
 
     from ..dressing import wrap
+    from ..dressing.rewrap import rewrap
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C in the terminal is for the app, which ends this process
 
@@ -32,9 +34,13 @@ def _serve(conn) -> None:  # noqa: ANN001 - a multiprocessing Connection
             job = conn.recv()
         except EOFError:
             return
-        body, pattern, strokes, params = job
+        kind, body, garment, strokes, extra = job
         try:
-            conn.send(("ok", wrap(body, pattern, strokes, params=params)))
+            if kind == "wrap":
+                result = wrap(body, garment, strokes, params=extra)
+            else:
+                result = rewrap(body, garment, strokes, pins=extra).garment
+            conn.send(("ok", result))
         except InputError as e:
             conn.send(("input", e.message, e.path))
         except ComputationError as e:
@@ -69,10 +75,18 @@ class WrapWorker:
 
         Raises what wrap raises (InputError, ComputationError), Cancelled when `cancel` is set, and
         ComputationError ("wrap") when the child dies or the wrap takes longer than `timeout_s`."""
+        return self._run(("wrap", body, pattern, strokes, params), cancel, timeout_s)
+
+    def rewrap(self, body, garment, strokes, pins, *, cancel: threading.Event | None = None, timeout_s: float = 600):  # noqa: ANN001, ANN201
+        """The garment (a GarmentFile) of `kitsuke.dressing.rewrap.rewrap(body, garment, strokes, pins=pins)`,
+        computed in the child; raises as `wrap` does."""
+        return self._run(("rewrap", body, garment, strokes, pins), cancel, timeout_s)
+
+    def _run(self, job: tuple, cancel: threading.Event | None, timeout_s: float):  # noqa: ANN202
         with self._lock:
             if self._proc is None or not self._proc.is_alive():
                 self._start()
-            self._conn.send((body, pattern, strokes, params))
+            self._conn.send(job)
             t0 = time.monotonic()
             while not self._conn.poll(0.1):
                 if cancel is not None and cancel.is_set():

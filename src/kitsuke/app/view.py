@@ -1,0 +1,603 @@
+"""What one browser tab sees and does: its scene (the body, the pattern board, strokes, the garment), its panel
+of tools, and its `DressingSession`. Thin: what a button or a stroke does is a session or library call.
+
+Drawing: press and drag on a pattern piece draws a pattern stroke; the next press-drag on the body draws its
+partner (pairs are numbered and coloured alike). Dragging on empty space turns the view. viser reports a drag as
+the pointer's position on a camera-facing plane; the view turns it into a ray from the camera and hits the
+board's plane or the body itself (`Surface.cast`), so strokes lie on what was drawn on.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import ComputationError, InputError
+from .board import BoardLayout
+from .dragger import Dragger
+from .session import DressingSession, pair_color
+from .worker import Cancelled
+
+if TYPE_CHECKING:
+    from .server import App
+
+#: Largest file accepted from the browser, bytes (the issue's 50 MB).
+MAX_UPLOAD_BYTES = 50 * 2**20
+BODY_COLOR = (214, 190, 170)
+GARMENT_COLOR = (70, 95, 160)
+PIECE_COLOR = (246, 240, 228)
+BODY_SUFFIXES = (".obj", ".glb", ".gltf", ".ply")
+PATTERN_SUFFIXES = (".json", ".svg")
+
+
+@dataclass
+class _Drawing:
+    """A stroke being drawn: on a piece (its name) or on the body (piece None); points so far."""
+
+    piece: str | None
+    points: list[np.ndarray] = field(default_factory=list)
+
+
+class ClientView:
+    """What one browser tab sees and does: its scene, its panel, its session."""
+
+    def __init__(self, app: App, client) -> None:  # noqa: ANN001 - a viser ClientHandle
+        self.app = app
+        self.client = client
+        self.session = DressingSession(app.body, app.pattern, app.strokes)
+        self.board = BoardLayout.of(app.pattern)
+        self.drawing: _Drawing | None = None
+        self.cancel = threading.Event()
+        self.busy = False
+        self._build_scene()
+        self._build_panel()
+        self._redraw_strokes()
+
+    # -- scene ------------------------------------------------------------------------------------------------
+    def _build_scene(self) -> None:
+        from ..pattern import mesh_pattern
+
+        scene = self.client.scene
+        mesh = self.session.body.mesh
+        self.body_handle = scene.add_mesh_simple(
+            "/body", mesh.vertices.astype(np.float32), mesh.faces.astype(np.uint32), color=BODY_COLOR
+        )
+        self.body_handle.on_drag()(self._on_body_drag)
+        pm = mesh_pattern(self.session.pattern, edge_length=8.0)
+        self.piece_handles = {}
+        for k, name in enumerate(pm.piece_names):
+            f0, f1 = pm.piece_faces[k]
+            v0, v1 = pm.piece_vertices[k]
+            verts = self.board.to_board(name, pm.vertices_cm[v0:v1])
+            faces = pm.faces[f0:f1] - v0
+            h = scene.add_mesh_simple(
+                f"/board/{name}", verts.astype(np.float32), faces.astype(np.uint32), color=PIECE_COLOR, side="double"
+            )
+            h.on_drag()(self._piece_drag_handler(name))
+            self.piece_handles[name] = h
+            piece = self.session.pattern.piece(name)
+            outline = np.concatenate([piece.sample_edge(e)[:-1] for e in range(piece.n_edges)])
+            ring = self.board.to_board(name, outline) + [0, 0, 0.002]
+            scene.add_line_segments(
+                f"/board/{name}/outline", np.stack([ring, np.roll(ring, -1, axis=0)], axis=1), (60, 60, 60),
+                thickness=2.0, thickness_units="screen",
+            )  # fmt: skip
+            low, high = piece.bounds
+            top = self.board.to_board(name, np.array([[(low[0] + high[0]) / 2, high[1]]]))[0]
+            scene.add_label(f"/board/{name}/name", name, position=tuple(top + [0, 0.03, 0]), anchor="bottom-center")
+        self._draw_seams()
+
+    def _draw_seams(self) -> None:
+        """Each seam as thin lines between its two edges' midpoints, numbered."""
+        pattern = self.session.pattern
+        segments = []
+        for seam in pattern.seams:
+            a = pattern.piece(seam.a.piece).edge_points(seam.a.edge, np.array([0.5]))
+            b = pattern.piece(seam.b.piece).edge_points(seam.b.edge, np.array([0.5]))
+            segments.append([self.board.to_board(seam.a.piece, a)[0], self.board.to_board(seam.b.piece, b)[0]])
+        if segments:
+            pts = np.array(segments) + [0, 0, 0.004]
+            self.seam_handle = self.client.scene.add_line_segments(
+                "/board/seams", pts, (150, 150, 220), thickness=1.0, thickness_units="screen"
+            )
+
+    def _redraw_strokes(self) -> None:
+        scene = self.client.scene
+        for handle in getattr(self, "_stroke_handles", []):
+            handle.remove()
+        self._stroke_handles = []
+        s = self.session
+        for pair in s.pairs:
+            color = pair_color(pair.id)
+            on_board = self.board.to_board(pair.pattern.piece, s.pattern_points_on_piece(pair)) + [0, 0, 0.006]
+            on_body = pair.body.surface_points + s.surface.normals_at(pair.body.faces) * 0.004
+            for name, pts in ((f"/strokes/{pair.id}/pattern", on_board), (f"/strokes/{pair.id}/body", on_body)):
+                self._stroke_handles.append(self._polyline(name, pts, color))
+            self._stroke_handles.append(
+                scene.add_label(f"/strokes/{pair.id}/label", str(pair.id), position=tuple(on_body[0]))
+            )
+        for pair in s.garment_pairs:
+            color = pair_color(pair.id)
+            on_board = self.board.to_board(pair.pattern.piece, pair.pattern.points) + [0, 0, 0.006]
+            self._stroke_handles.append(self._polyline(f"/rewrap/{pair.id}/pattern", on_board, color))
+            self._stroke_handles.append(
+                self._polyline(f"/rewrap/{pair.id}/garment", pair.body.surface_points + [0, 0, 0.004], color)
+            )
+        shown = s.waiting if self.laser.value else s.waiting[-1:]
+        for k, stroke in enumerate(shown):
+            pts = self.board.to_board(stroke.piece, self._piece_points(stroke)) + [0, 0, 0.006]
+            self._stroke_handles.append(self._polyline(f"/strokes/pending{k}", pts, (40, 40, 40)))
+        self._status()
+
+    def _piece_points(self, stroke) -> np.ndarray:  # noqa: ANN001 - a PatternStroke in file coordinates
+        return self.session.pattern.file_to_piece(stroke.piece, stroke.points)
+
+    def _polyline(self, name: str, pts: np.ndarray, color: tuple[int, int, int]):  # noqa: ANN202
+        seg = np.stack([pts[:-1], pts[1:]], axis=1)
+        return self.client.scene.add_line_segments(name, seg, color, thickness=4.0, thickness_units="screen")
+
+    # -- drawing ----------------------------------------------------------------------------------------------
+    def _ray(self, event) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001
+        """The pointer's ray at a drag event: from the camera through the reported point."""
+        eye = np.asarray(event.client.camera.position, dtype=np.float64)
+        through = np.asarray(event.end_position, dtype=np.float64)
+        return eye, through - eye
+
+    def _piece_drag_handler(self, piece: str):  # noqa: ANN202
+        async def handler(event) -> None:  # noqa: ANN001
+            if event.phase == "start":
+                self.drawing = _Drawing(piece, [np.asarray(event.start_position, dtype=np.float64)])
+                return
+            if self.drawing is None or self.drawing.piece != piece:
+                return
+            hit = self.board.on_board(*self._ray(event))
+            if hit is not None:
+                self.drawing.points.append(hit)
+            if event.phase == "end":
+                drawn, self.drawing = self.drawing, None
+                self._finish_pattern_stroke(drawn)
+
+        return handler
+
+    async def _on_body_drag(self, event) -> None:  # noqa: ANN001
+        if self.laser.value:
+            return self._laser_drag(event)
+        if event.phase == "start":
+            self.drawing = _Drawing(None, [np.asarray(event.start_position, dtype=np.float64)])
+            return
+        if self.drawing is None or self.drawing.piece is not None:
+            return
+        eye, direction = self._ray(event)
+        hit = self.session.surface.cast(eye[None], direction[None], hit="first")
+        if hit.hit.all():
+            self.drawing.points.append(hit.points[0])
+        if event.phase == "end":
+            drawn, self.drawing = self.drawing, None
+            self._finish_body_stroke(drawn)
+
+    def _laser_drag(self, event) -> None:  # noqa: ANN001
+        """A laser stroke: the pointer's rays, kept whole (origin and direction) for both of their hits."""
+        eye = np.asarray(event.client.camera.position, dtype=np.float64)
+        if event.phase == "start":
+            self.drawing = _Drawing(None, [np.r_[eye, np.asarray(event.start_position) - eye]])
+            return
+        if self.drawing is None or self.drawing.piece is not None:
+            return
+        self.drawing.points.append(np.r_[self._ray(event)])
+        if event.phase == "end":
+            rays, self.drawing = np.array(self.drawing.points), None
+            if len(rays) >= 2:
+                try:
+                    self.session.draw_laser_stroke(rays)
+                except InputError as e:
+                    self.notify("Laser stroke not kept", e.message, "yellow")
+            self._redraw_strokes()
+
+    def _finish_pattern_stroke(self, drawn: _Drawing) -> None:
+        pts = np.array(drawn.points)
+        if len(pts) < 2:
+            return
+        local = self.board.to_piece(drawn.piece, pts)
+        try:
+            self.session.draw_pattern_stroke(drawn.piece, self.session.pattern.piece_to_file(drawn.piece, local))
+        except InputError as e:
+            self.notify("That stroke was not kept", e.message, "red")
+        self._redraw_strokes()
+
+    def _finish_body_stroke(self, drawn: _Drawing) -> None:
+        pts = np.array(drawn.points)
+        if len(pts) < 2:
+            return
+        try:
+            self.session.draw_body_stroke(pts)
+        except InputError as e:
+            self.notify("Draw on the pattern first", e.message, "yellow")
+        self._redraw_strokes()
+
+    # -- panel ------------------------------------------------------------------------------------------------
+    def _build_panel(self) -> None:
+        gui = self.client.gui
+        self.status = gui.add_markdown("")
+        with gui.add_folder("Strokes"):
+            gui.add_button("Undo", icon="arrow-back-up").on_click(lambda _: self._edit(self.session.undo))
+            gui.add_button("Redo", icon="arrow-forward-up").on_click(lambda _: self._edit(self.session.redo))
+            gui.add_button("Suggest strokes").on_click(lambda _: self._edit(self.session.suggest))
+            gui.add_button("Clear strokes").on_click(lambda _: self._edit(self.session.clear))
+            self.laser = gui.add_checkbox(
+                "Laser (front and back)", False,
+                hint="one stroke across the body lands on its front and its back, for the last two pattern strokes",
+            )  # fmt: skip
+            self.laser.on_update(lambda _: self._redraw_strokes())
+        with gui.add_folder("View"):
+            seams = gui.add_checkbox("Show seams", True)
+            seams.on_update(lambda _: self._show_seams(seams.value))
+            pieces = self.session.pattern.piece_names
+            self.flip_choice = gui.add_dropdown("Piece", pieces, initial_value=pieces[0])
+            gui.add_button("Turn piece over").on_click(lambda _: self._flip(self.flip_choice.value))
+        with gui.add_folder("Wrap"):
+            self.edge = gui.add_number(
+                "Mesh edge (cm)", self.app.options.edge_length, min=0.5, max=5.0, step=0.5,
+                hint="the garment's triangle size: larger is faster to wrap and to drag, with coarser folds",
+            )  # fmt: skip
+            self.wrap_button = gui.add_button("Wrap", color="blue", icon="shirt")
+            self.wrap_button.on_click(lambda _: self._start_wrap())
+            self.cancel_button = gui.add_button("Cancel wrap", disabled=True)
+            self.cancel_button.on_click(lambda _: self.cancel.set())
+        with gui.add_folder("Drag the garment"):
+            self.pin_mode = gui.add_checkbox("Click to pin / unpin", False)
+            self.rewrap_mode = gui.add_checkbox(
+                "Draw on the garment (re-wrap)", False,
+                hint="a stroke on a pattern piece, then one on the garment where that cloth should go; then Re-wrap",
+            )  # fmt: skip
+            gui.add_button("Re-wrap").on_click(lambda _: self._start_rewrap())
+            gui.add_button("Unpin all").on_click(lambda _: self._unpin_all())
+            gui.add_button("Undo drag").on_click(lambda _: self._drag_history(undo=True))
+            gui.add_button("Redo drag").on_click(lambda _: self._drag_history(undo=False))
+            self.drag_rate = gui.add_markdown("Wrap first; then press and drag on the garment.")
+        with gui.add_folder("Files"):
+            gui.add_upload_button("Open body (OBJ, GLB, PLY)").on_upload(self._upload_body)
+            gui.add_upload_button("Open pattern (JSON, SVG)").on_upload(self._upload_pattern)
+            gui.add_upload_button("Open strokes (JSON)").on_upload(self._upload_strokes)
+            gui.add_button("Save strokes").on_click(lambda _: self._download_strokes())
+            gui.add_button("Save garment (GLB, OBJ, report)").on_click(lambda _: self._download_garment())
+
+    def _unpin_all(self) -> None:
+        if getattr(self, "dragging", None) is not None and not self.dragger.busy:
+            self.drag_undo.append(self.dragging.snapshot())
+            self.dragging.unpin(all=True)
+            self._show_pins()
+
+    def _show_seams(self, on: bool) -> None:
+        if getattr(self, "seam_handle", None) is not None:
+            self.seam_handle.visible = on
+
+    def _flip(self, piece: str) -> None:
+        """Turn a piece over (its back becomes its outside): a new pattern, so a new session."""
+        pattern = self.session.pattern.copy()
+        k = pattern.piece_index(piece)
+        pattern.pieces[k].flipped = not pattern.pieces[k].flipped
+        self._replace(pattern=pattern)
+
+    def _status(self, extra: str = "") -> None:
+        s = self.session
+        lines = [f"**{s.pattern.name}** on the body: {len(s.pairs)} stroke pair(s)."]
+        if s.garment_pairs:
+            lines.append(f"{len(s.garment_pairs)} re-wrap stroke pair(s) drawn on the garment.")
+        if self.laser.value:
+            if len(s.waiting) < 2:
+                lines.append("Laser: draw a stroke on a front piece, then one on a back piece.")
+            else:
+                lines.append(f"Laser: now one stroke across the body for *{s.waiting[0].piece}* (front) and "
+                             f"*{s.waiting[1].piece}* (back).")  # fmt: skip
+        elif s.pending is not None:
+            lines.append(f"Stroke {s.next_id()} drawn on *{s.pending.piece}*: now draw its partner on the body.")
+        else:
+            lines.append("Draw a stroke on a pattern piece, then its partner on the body.")
+        if extra:
+            lines.append(extra)
+        self.status.content = "\n\n".join(lines)
+
+    def _edit(self, action) -> None:  # noqa: ANN001
+        try:
+            action()
+        except InputError as e:
+            self.notify("Could not do that", e.message, "red")
+        self._redraw_strokes()
+
+    def notify(self, title: str, body: str, color: str | None = None) -> None:
+        self.client.add_notification(title, body, color=color, auto_close_seconds=8.0)
+
+    # -- wrap and re-wrap ----------------------------------------------------------------------------------
+    def _start_wrap(self) -> None:
+        from dataclasses import replace
+
+        s = self.session
+        strokes = s.strokes()
+        if not len(strokes):
+            self.notify("No strokes yet", "Draw at least one stroke pair (pattern, then body) to wrap.", "yellow")
+            return
+        params = replace(self.app.options, edge_length=float(self.edge.value)).wrap_params(s.body, s.pattern)
+        self._start_job(
+            "Wrapping", lambda: self.app.worker.wrap(s.body, s.pattern, strokes, params, cancel=self.cancel),
+            self._wrapped,
+        )  # fmt: skip
+
+    def _start_rewrap(self) -> None:
+        s, d = self.session, getattr(self, "dragging", None)
+        if d is None or not s.garment_pairs:
+            self.notify("Nothing to re-wrap", "Wrap first; then draw a stroke on the pattern and where it should "
+                        "go on the garment (Draw on the garment ticked).", "yellow")  # fmt: skip
+            return
+        garment, strokes, pins = d.garment(), s.garment_strokes(), d.positions[d.pinned].copy()
+        self._start_job(
+            "Re-wrapping", lambda: self.app.worker.rewrap(s.body, garment, strokes, pins, cancel=self.cancel),
+            self._rewrapped,
+        )  # fmt: skip
+
+    def _start_job(self, title: str, compute, done) -> None:  # noqa: ANN001
+        """Run `compute` (a wrap or re-wrap in the worker) in a thread, with its elapsed time shown and Cancel
+        armed; `done(result)` takes what it gives."""
+        if self.busy:
+            return
+        self.busy = True
+        self.cancel.clear()
+        self.wrap_button.disabled = True
+        self.cancel_button.disabled = False
+        threading.Thread(target=self._job, args=(title, compute, done), daemon=True, name="kitsuke-app-job").start()
+
+    def _job(self, title: str, compute, done) -> None:  # noqa: ANN001
+        note = self.client.add_notification(title, "0 s", loading=True, with_close_button=False)
+        ticking = threading.Event()
+
+        def tick() -> None:  # the elapsed time, so that a long wrap is seen to be working
+            t0 = time.monotonic()
+            while not ticking.wait(0.5):
+                note.body = f"{time.monotonic() - t0:.0f} s (Cancel wrap stops it)"
+
+        threading.Thread(target=tick, daemon=True).start()
+        try:
+            result = compute()
+        except Cancelled:
+            self._job_ended(note, ticking, f"{title} cancelled", "Nothing changed.", "yellow")
+            return
+        except (InputError, ComputationError) as e:
+            reason = e.message if isinstance(e, InputError) else f"{e.stage}: {e.message}"
+            self._job_ended(note, ticking, f"{title} failed", reason, "red")
+            return
+        title, body, color = done(result)
+        self._job_ended(note, ticking, title, body, color)
+        self._status(body)
+
+    def _wrapped(self, garment) -> tuple[str, str, str]:  # noqa: ANN001 - a DressedGarment
+        from ..dressing import target_misses
+
+        self.session.garment = garment
+        self.session.garment_changed()
+        self._start_drag(garment)
+        misses = target_misses(garment)
+        verdict = "all quality targets met" if not misses else "missed: " + "; ".join(misses)
+        summary = f"Dressed: {garment.n_vertices} vertices, {garment.timings.get('wrap', 0.0):.1f} s; {verdict}."
+        return "Dressed", summary, "green" if not misses else "yellow"
+
+    def _rewrapped(self, garment) -> tuple[str, str, str]:  # noqa: ANN001 - a GarmentFile
+        self.session.garment_changed()
+        self._start_drag(garment)
+        self._redraw_strokes()
+        return "Re-wrapped", f"Re-wrapped: {len(garment.positions)} vertices.", "green"
+
+    # -- drag and pins ----------------------------------------------------------------------------------------
+    def _start_drag(self, garment) -> None:  # noqa: ANN001 - a DressedGarment
+        from ..dressing import DragSession
+
+        self.dragging = DragSession(self.session.body, garment)
+        self.drag_undo: list = []
+        self.drag_redo: list = []
+        self.dragger = Dragger(self)
+        self._show_garment()
+
+    def _show_garment(self) -> None:
+        """(Re)build the garment's scene node from the drag session (a release may refine its mesh)."""
+        d = self.dragging
+        self.garment_handle = self.client.scene.add_mesh_simple(
+            "/garment", d.positions.astype(np.float32), d.model.faces.astype(np.uint32),
+            color=GARMENT_COLOR, side="double",
+        )  # fmt: skip
+        self.garment_handle.on_drag()(self._on_garment_drag)
+        self.garment_handle.on_click()(self._on_garment_click)
+        self._shown_vertices = d.n_vertices
+        self._show_pins()
+
+    def _show_pins(self) -> None:
+        d = self.dragging
+        pts = d.positions[d.pinned]
+        if len(pts):
+            self.client.scene.add_point_cloud(
+                "/pins", pts.astype(np.float32), (255, 200, 0), point_size=0.02, point_shape="circle"
+            )
+        else:
+            self.client.scene.remove_by_name("/pins")
+
+    def push_positions(self) -> None:
+        """Send the garment's vertices (only them) to the browser."""
+        d = self.dragging
+        if d.n_vertices != self._shown_vertices:
+            self._show_garment()
+        else:
+            self.garment_handle.vertices = d.positions.astype(np.float32)
+
+    async def _on_garment_drag(self, event) -> None:  # noqa: ANN001
+        if self.rewrap_mode.value:
+            return self._garment_stroke_drag(event)
+        if event.phase == "start":
+            self.dragger.submit("grab", np.asarray(event.start_position, dtype=np.float64))
+        elif event.phase == "update":
+            self.dragger.submit("move", self._body_target(event))
+        else:
+            self.dragger.submit("release", None)
+
+    def _garment_stroke_drag(self, event) -> None:  # noqa: ANN001
+        """A re-wrap stroke drawn on the garment as it is now."""
+        from ..geometry import TriMesh
+        from ..geometry.surface import Surface
+
+        if event.phase == "start":
+            d = self.dragging
+            self._cloth_surface = Surface(TriMesh(d.positions.copy(), d.model.faces))
+            self.drawing = _Drawing(None, [np.asarray(event.start_position, dtype=np.float64)])
+            return
+        if self.drawing is None or self.drawing.piece is not None:
+            return
+        eye, direction = self._ray(event)
+        hit = self._cloth_surface.cast(eye[None], direction[None], hit="first")
+        if hit.hit.all():
+            self.drawing.points.append(hit.points[0])
+        if event.phase == "end":
+            pts, self.drawing = np.array(self.drawing.points), None
+            if len(pts) >= 2:
+                try:
+                    self.session.draw_garment_stroke(pts, self._cloth_surface)
+                except InputError as e:
+                    self.notify("Draw on the pattern first", e.message, "yellow")
+            self._redraw_strokes()
+
+    def _body_target(self, event) -> np.ndarray:  # noqa: ANN001
+        """Where the pointer is on the body (its ray's first hit), or the body point nearest the pointer's place
+        on the camera-facing plane when the ray misses the body."""
+        eye, direction = self._ray(event)
+        hit = self.session.surface.cast(eye[None], direction[None], hit="first")
+        if hit.hit.all():
+            return hit.points[0]
+        return self.session.surface.closest(np.asarray(event.end_position, dtype=np.float64)[None]).points[0]
+
+    async def _on_garment_click(self, event) -> None:  # noqa: ANN001
+        if not self.pin_mode.value or self.dragger.busy:
+            return
+        from ..geometry import TriMesh
+        from ..geometry.surface import Surface
+
+        d = self.dragging
+        cloth = Surface(TriMesh(d.positions, d.model.faces))
+        hit = cloth.cast(np.asarray(event.ray_origin)[None], np.asarray(event.ray_direction)[None], hit="first")
+        if not hit.hit.all():
+            return
+        v = int(d.model.faces[hit.faces[0]][np.argmax(hit.barycentric[0])])
+        self.drag_undo.append(d.snapshot())
+        self.drag_redo.clear()
+        if d.pinned[v]:
+            d.unpin(vertices=[v])
+        else:
+            d.pin(vertices=[v])
+        self._show_pins()
+
+    def _drag_history(self, undo: bool) -> None:
+        if getattr(self, "dragging", None) is None or self.dragger.busy:
+            return
+        src, dst = (self.drag_undo, self.drag_redo) if undo else (self.drag_redo, self.drag_undo)
+        if not src:
+            return
+        dst.append(self.dragging.snapshot())
+        self.dragging.restore(src.pop())
+        self.push_positions()
+        self._show_pins()
+
+    def _job_ended(self, note, ticking: threading.Event, title: str, body: str, color: str) -> None:  # noqa: ANN001
+        ticking.set()
+        note.remove()
+        self.notify(title, body, color)
+        self.busy = False
+        self.wrap_button.disabled = False
+        self.cancel_button.disabled = True
+
+    # -- files ------------------------------------------------------------------------------------------------
+    def _received(self, event, suffixes: tuple[str, ...]) -> Path | None:  # noqa: ANN001
+        """An uploaded file written to this session's own folder under a fixed name (never a browser's path),
+        or None after telling the user why not."""
+        f = event.target.value
+        suffix = Path(f.name).suffix.lower()
+        if suffix not in suffixes:
+            self.notify("Not opened", f"{f.name}: expected {', '.join(suffixes)}", "red")
+            return None
+        if len(f.content) > MAX_UPLOAD_BYTES:
+            self.notify("Not opened", f"{f.name}: larger than {MAX_UPLOAD_BYTES // 2**20} MB", "red")
+            return None
+        path = Path(self.app.uploads.name) / f"{self.client.client_id}-upload{suffix}"
+        path.write_bytes(f.content)
+        return path
+
+    def _upload_body(self, event) -> None:  # noqa: ANN001
+        from ..body import load_body
+
+        path = self._received(event, BODY_SUFFIXES)
+        if path is None:
+            return
+        try:
+            body = load_body(path)
+        except InputError as e:
+            self.notify("Not a body this app can use", f"{event.target.value.name}: {e.message}", "red")
+            return
+        self._replace(body=body)
+
+    def _upload_pattern(self, event) -> None:  # noqa: ANN001
+        from ..pattern import load_pattern
+
+        path = self._received(event, PATTERN_SUFFIXES)
+        if path is None:
+            return
+        try:
+            pattern = load_pattern(path)
+        except InputError as e:
+            self.notify("Not a pattern this app can use", f"{event.target.value.name}: {e.message}", "red")
+            return
+        self._replace(pattern=pattern)
+
+    def _upload_strokes(self, event) -> None:  # noqa: ANN001
+        from ..dressing import read_strokes
+
+        path = self._received(event, (".json",))
+        if path is None:
+            return
+        try:
+            self.session.load_strokes(read_strokes(path))
+        except InputError as e:
+            self.notify("Strokes not loaded", f"{event.target.value.name}: {e.message}", "red")
+            return
+        self._redraw_strokes()
+
+    def _replace(self, *, body=None, pattern=None) -> None:  # noqa: ANN001
+        """A new body or pattern: a fresh session (strokes belong to the old ones), the scene rebuilt."""
+        s = self.session
+        self.session = DressingSession(body or s.body, pattern or s.pattern)
+        self.board = BoardLayout.of(self.session.pattern)
+        self.client.scene.reset()
+        self._build_scene()
+        self._redraw_strokes()
+
+    def _download_strokes(self) -> None:
+        from ..dressing import strokes_to_json
+
+        self.client.send_file_download(
+            "strokes.json", strokes_to_json(self.session.strokes()).encode(), save_immediately=True
+        )
+
+    def _download_garment(self) -> None:
+        """The garment as it is now (dragged, pinned) with its quality report."""
+        from .._files import write_json_atomic
+        from ..dressing.export import write_garment_glb, write_garment_obj
+
+        if getattr(self, "dragging", None) is None:
+            self.notify("Nothing dressed yet", "Wrap first, then save the garment.", "yellow")
+            return
+        garment, body = self.dragging.garment(), self.session.body.mesh
+        with tempfile.TemporaryDirectory() as d:
+            paths = [Path(d) / n for n in ("garment.glb", "garment.obj", "garment_report.json")]
+            write_garment_glb(garment, paths[0], body=body)
+            write_garment_obj(garment, paths[1])
+            write_json_atomic(paths[2], self.dragging.report().to_dict())
+            for p in paths:
+                self.client.send_file_download(p.name, p.read_bytes(), save_immediately=True)
