@@ -357,3 +357,103 @@ def test_laser_stroke_in_the_browser(app_page):
     assert len(pairs) == 2
     assert (pairs[0].body.surface_points[:, 2] > 0.05).all()  # entered at the front
     assert (pairs[1].body.surface_points[:, 2] < 0.05).all()  # left at the back
+
+
+def _skirt_from_nothing(body):
+    """The issue's skirt: a rectangle drawn, duplicated, its two side seams sewn (through the editor)."""
+    from kitsuke.app.editor import PatternEditor
+    from kitsuke.pattern._types import EdgeRef
+
+    ed = PatternEditor(default_kimono())
+    ed.new("skirt")
+    front = ed.add_piece([[0, 55], [60, 55], [60, 0], [0, 0]])  # clockwise, as a hand might click them
+    back = ed.duplicate(front)
+    assert ed.sew(EdgeRef(front, 1), EdgeRef(back, 3)) is None
+    assert ed.sew(EdgeRef(front, 3), EdgeRef(back, 1)) is None
+    return ed
+
+
+def test_editor_builds_a_skirt_that_hangs_round_the_waist(body):
+    from kitsuke.dressing import wrap
+    from kitsuke.dressing.options import DressOptions
+
+    ed = _skirt_from_nothing(body)
+    p = ed.pattern
+    assert p.piece_names == ["piece1", "piece1_copy1"] and len(p.seams) == 2
+    assert [i for i in ed.issues() if i.startswith("error")] == []
+    s = DressingSession(body, p)
+    for piece, z, xs in (("piece1", 1, (-0.12, 0.12)), ("piece1_copy1", -1, (0.12, -0.12))):
+        s.draw_pattern_stroke(piece, np.array([[15.0, 45.0], [45.0, 45.0]]))
+        surface = Surface(body.mesh)
+        xs_ = np.linspace(*xs, 5)
+        o = np.c_[xs_, np.full(5, 0.95), np.full(5, 2.0 * z)]
+        s.draw_body_stroke(surface.cast(o, np.tile([0, 0, -z], (5, 1))).points)
+    g = wrap(body, p, s.strokes(), params=DressOptions().wrap_params(body, p))
+    lo, hi = g.positions.min(axis=0), g.positions.max(axis=0)
+    assert 0.85 < hi[1] < 1.1 and lo[1] > 0.3  # from the waist down, not to the floor
+    angle = np.degrees(np.arctan2(g.positions[:, 2] - 0.03, g.positions[:, 0]))
+    assert len(np.unique(np.floor(angle / 10))) == 36  # all the way round
+    from kitsuke.dressing import target_misses
+
+    assert target_misses(g) == []
+
+
+def test_editor_undo_mirror_unsew(body):
+    from kitsuke.pattern._types import EdgeRef
+
+    ed = _skirt_from_nothing(body)
+    n = len(ed.pattern.seams)
+    ed.unsew(EdgeRef("piece1", 1))
+    assert len(ed.pattern.seams) == n - 1
+    ed.undo()
+    assert len(ed.pattern.seams) == n
+    with pytest.raises(InputError, match="already sewn"):
+        ed.sew(EdgeRef("piece1", 1), EdgeRef("piece1", 0))
+    tri = ed.add_piece([[0, 0], [40, 0], [0, 30]])
+    warning = ed.sew(EdgeRef(tri, 0), EdgeRef("piece1", 0))  # 40 cm against 60 cm
+    assert warning is not None and "differ in length" in warning
+    before = ed.pattern.piece(tri).outline.copy()
+    ed.mirror(tri)
+    after = ed.pattern.piece(tri).outline
+    assert ed.pattern.piece(tri).signed_area > 0  # still counter-clockwise
+    np.testing.assert_allclose(sorted(after[:, 1]), sorted(before[:, 1]))
+    assert ed.pattern.edge_length(EdgeRef(tri, 2)) == pytest.approx(40.0)  # edge 0 is now edge n-1-0
+    assert any(EdgeRef(tri, 2) in (s.a, s.b) for s in ed.pattern.seams)  # and its seam went with it
+    with pytest.raises(InputError, match="no area"):
+        ed.add_piece([[0, 0], [10, 0], [20, 0]])
+
+
+def test_draw_a_piece_and_sew_in_the_browser(app_page):
+    """Click four corners on the board, close the piece, duplicate it, sew two edges by clicking them."""
+    view, page = app_page.view, app_page.page
+    page.get_by_text("Edit the pattern").click()
+    page.get_by_role("button", name="New empty pattern").click()
+    page.wait_for_timeout(800)
+    assert view.session.pattern.pieces == []
+    page.get_by_text("Draw a piece: click its corners").click()
+    page.wait_for_timeout(300)
+    z = view.board.z
+    for x, y in ((0.8, 1.2), (1.1, 1.2), (1.1, 1.5), (0.8, 1.5)):
+        px = app_page.screen(np.array([[x, y, z]]))[0]
+        page.mouse.click(float(px[0]), float(px[1]))
+        page.wait_for_timeout(250)
+    assert len(view.corners) == 4
+    page.get_by_role("button", name="Close the piece").click()
+    page.wait_for_timeout(800)
+    assert view.session.pattern.piece_names == ["piece1"]
+    w, h = view.session.pattern.piece("piece1").bounds[1]
+    assert abs(w - 60) < 4 and abs(h - 60) < 4  # 0.3 m on the board = 60 cm of pattern
+    page.get_by_text("Draw a piece: click its corners").click()  # off
+    page.get_by_role("button", name="Duplicate piece").click()
+    page.wait_for_timeout(800)
+    assert len(view.session.pattern.pieces) == 2
+    page.get_by_text("Sew: click two edges").click()
+    page.wait_for_timeout(300)
+    a, b = view.session.pattern.piece_names
+    for piece, pt in ((a, [w, h / 2]), (b, [0.0, h / 2])):  # a's right side, b's left side
+        px = app_page.screen(view.board.to_board(piece, np.array([pt]) + [[-1.0 if piece == a else 1.0, 0]]))[0]
+        page.mouse.click(float(px[0]), float(px[1]))
+        page.wait_for_timeout(500)
+    seams = view.session.pattern.seams
+    assert len(seams) == 1
+    assert {seams[0].a.piece, seams[0].b.piece} == {a, b}

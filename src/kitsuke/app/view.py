@@ -21,6 +21,7 @@ import numpy as np
 from ..errors import ComputationError, InputError
 from .board import BoardLayout
 from .dragger import Dragger
+from .editor import PatternEditor
 from .session import DressingSession, pair_color
 from .worker import Cancelled
 
@@ -51,13 +52,17 @@ class ClientView:
         self.app = app
         self.client = client
         self.session = DressingSession(app.body, app.pattern, app.strokes)
+        self.editor = PatternEditor(app.pattern)
         self.board = BoardLayout.of(app.pattern)
+        self.corners: list[np.ndarray] = []  # a piece being drawn, corner by corner (board metres)
+        self.sewing: list = []  # the first edge picked for a seam
         self.drawing: _Drawing | None = None
         self.cancel = threading.Event()
         self.busy = False
         self._build_scene()
         self._build_panel()
         self._redraw_strokes()
+        client.scene.on_click()(self._on_scene_click)  # corners of a piece being drawn (once: scenes are rebuilt)
 
     # -- scene ------------------------------------------------------------------------------------------------
     def _build_scene(self) -> None:
@@ -69,8 +74,10 @@ class ClientView:
             "/body", mesh.vertices.astype(np.float32), mesh.faces.astype(np.uint32), color=BODY_COLOR
         )
         self.body_handle.on_drag()(self._on_body_drag)
-        pm = mesh_pattern(self.session.pattern, edge_length=8.0)
         self.piece_handles = {}
+        if not self.session.pattern.pieces:  # a new, empty pattern: only the body, until a piece is drawn
+            return
+        pm = mesh_pattern(self.session.pattern, edge_length=8.0)
         for k, name in enumerate(pm.piece_names):
             f0, f1 = pm.piece_faces[k]
             v0, v1 = pm.piece_vertices[k]
@@ -80,6 +87,7 @@ class ClientView:
                 f"/board/{name}", verts.astype(np.float32), faces.astype(np.uint32), color=PIECE_COLOR, side="double"
             )
             h.on_drag()(self._piece_drag_handler(name))
+            h.on_click()(self._piece_click_handler(name))
             self.piece_handles[name] = h
             piece = self.session.pattern.piece(name)
             outline = np.concatenate([piece.sample_edge(e)[:-1] for e in range(piece.n_edges)])
@@ -240,6 +248,24 @@ class ClientView:
             pieces = self.session.pattern.piece_names
             self.flip_choice = gui.add_dropdown("Piece", pieces, initial_value=pieces[0])
             gui.add_button("Turn piece over").on_click(lambda _: self._flip(self.flip_choice.value))
+        with gui.add_folder("Edit the pattern", expand_by_default=False):
+            gui.add_button("New empty pattern").on_click(lambda _: self._new_pattern())
+            self.piece_mode = gui.add_checkbox("Draw a piece: click its corners", False)
+            gui.add_button("Close the piece").on_click(lambda _: self._close_piece())
+            self.sew_mode = gui.add_checkbox("Sew: click two edges", False)
+            gui.add_button("Duplicate piece").on_click(
+                lambda _: self._edit_pattern(lambda: self.editor.duplicate(self.flip_choice.value))
+            )
+            gui.add_button("Mirror piece").on_click(
+                lambda _: self._edit_pattern(lambda: self.editor.mirror(self.flip_choice.value))
+            )
+            gui.add_button("Delete piece").on_click(
+                lambda _: self._edit_pattern(lambda: self.editor.delete_piece(self.flip_choice.value))
+            )
+            gui.add_button("Undo edit").on_click(lambda _: self._edit_pattern(self.editor.undo))
+            gui.add_button("Redo edit").on_click(lambda _: self._edit_pattern(self.editor.redo))
+            gui.add_button("Save pattern (JSON)").on_click(lambda _: self._download_pattern())
+            self.issues_md = gui.add_markdown("")
         with gui.add_folder("Wrap"):
             self.edge = gui.add_number(
                 "Mesh edge (cm)", self.app.options.edge_length, min=0.5, max=5.0, step=0.5,
@@ -277,12 +303,81 @@ class ClientView:
         if getattr(self, "seam_handle", None) is not None:
             self.seam_handle.visible = on
 
+    # -- the pattern editor -----------------------------------------------------------------------------------
+    def _edit_pattern(self, action) -> None:  # noqa: ANN001 - an editor call
+        try:
+            warning = action()
+        except InputError as e:
+            self.notify("Not done", e.message, "red")
+            return
+        if isinstance(warning, str) and " differ in length" in warning:
+            self.notify("Sewn, but", warning, "yellow")
+        self._replace(pattern=self.editor.pattern, keep_editor=True)
+
+    def _on_scene_click(self, event) -> None:  # noqa: ANN001
+        """A corner of the piece being drawn, where the click's ray meets the board."""
+        if not self.piece_mode.value or event.ray_origin is None:
+            return
+        hit = self.board.on_board(np.asarray(event.ray_origin), np.asarray(event.ray_direction))
+        if hit is None:
+            return
+        self.corners.append(hit)
+        self._show_corners()
+
+    def _show_corners(self) -> None:
+        scene = self.client.scene
+        if not self.corners:
+            scene.remove_by_name("/new_piece")
+            return
+        pts = np.array(self.corners) + [0, 0, 0.008]
+        ring = np.vstack([pts, pts[:1]]) if len(pts) > 2 else pts
+        if len(ring) > 1:
+            self._polyline("/new_piece", ring, (200, 60, 20))
+        else:
+            scene.add_point_cloud("/new_piece", pts.astype(np.float32), (200, 60, 20), point_size=0.02)
+
+    def _new_pattern(self) -> None:
+        self._edit_pattern(self.editor.new)
+
+    def _close_piece(self) -> None:
+        if len(self.corners) < 3:
+            self.notify("A piece needs 3 corners", "Tick 'Draw a piece' and click its corners on the board.", "yellow")
+            return
+        cm = (np.array(self.corners)[:, :2]) / self.board.scale
+        self.corners = []
+        self._show_corners()
+        self._edit_pattern(lambda: self.editor.add_piece(cm))
+
+    def _piece_click_handler(self, piece: str):  # noqa: ANN202
+        def handler(event) -> None:  # noqa: ANN001
+            if not self.sew_mode.value:
+                return
+            hit = self.board.on_board(np.asarray(event.ray_origin), np.asarray(event.ray_direction))
+            if hit is None:
+                return
+            from ..pattern._types import EdgeRef
+
+            edge = EdgeRef(piece, self.editor.nearest_edge(piece, self.board.to_piece(piece, hit[None])[0]))
+            if not self.sewing:
+                self.sewing = [edge]
+                self._status(f"Edge {edge} picked: click the edge to sew it to.")
+                return
+            first, self.sewing = self.sewing[0], []
+            self._edit_pattern(lambda: self.editor.sew(first, edge))
+
+        return handler
+
     def _flip(self, piece: str) -> None:
-        """Turn a piece over (its back becomes its outside): a new pattern, so a new session."""
-        pattern = self.session.pattern.copy()
-        k = pattern.piece_index(piece)
-        pattern.pieces[k].flipped = not pattern.pieces[k].flipped
-        self._replace(pattern=pattern)
+        """Turn a piece over (its back becomes its outside)."""
+        self._edit_pattern(lambda: self.editor.flip(piece))
+
+    def _download_pattern(self) -> None:
+        from ..pattern import save_pattern
+
+        with tempfile.TemporaryDirectory() as d:
+            path = Path(d) / f"{self.editor.pattern.name}.json"
+            save_pattern(self.editor.pattern, path)
+            self.client.send_file_download(path.name, path.read_bytes(), save_immediately=True)
 
     def _status(self, extra: str = "") -> None:
         s = self.session
@@ -569,13 +664,29 @@ class ClientView:
             return
         self._redraw_strokes()
 
-    def _replace(self, *, body=None, pattern=None) -> None:  # noqa: ANN001
-        """A new body or pattern: a fresh session (strokes belong to the old ones), the scene rebuilt."""
+    def _replace(self, *, body=None, pattern=None, keep_editor: bool = False) -> None:  # noqa: ANN001
+        """A new body or pattern: a fresh session, the scene rebuilt. An edited pattern keeps the stroke pairs
+        that still lie on its pieces; a new body or an opened pattern starts without strokes."""
         s = self.session
-        self.session = DressingSession(body or s.body, pattern or s.pattern)
+        strokes = s.strokes() if keep_editor and body is None and len(s.strokes()) else None
+        try:
+            self.session = DressingSession(body or s.body, pattern or s.pattern, strokes)
+        except InputError:
+            self.session = DressingSession(body or s.body, pattern or s.pattern)
+            self.notify("Strokes dropped", "the edit moved a piece a stroke was drawn on", "yellow")
+        if not keep_editor:
+            self.editor = PatternEditor(self.session.pattern)
         self.board = BoardLayout.of(self.session.pattern)
         self.client.scene.reset()
         self._build_scene()
+        names = self.session.pattern.piece_names
+        if names and hasattr(self, "flip_choice"):
+            current = self.flip_choice.value
+            self.flip_choice.options = names
+            self.flip_choice.value = current if current in names else names[-1]
+        if hasattr(self, "issues_md"):
+            found = self.editor.issues()
+            self.issues_md.content = "\n\n".join(found[:6]) if found else "No problems found in the pattern."
         self._redraw_strokes()
 
     def _download_strokes(self) -> None:
