@@ -302,9 +302,14 @@ def test_latest_drops_frames_it_cannot_hand_out():
     assert all(isinstance(f, Frame) for f in got)
 
 
-def test_window_without_display_says_so(run_cli, monkeypatch):
-    monkeypatch.delenv("DISPLAY", raising=False)
+@pytest.mark.parametrize("display", [None, ":97", "not-a-display"])
+def test_window_without_display_says_so(run_cli, monkeypatch, display):
+    """No DISPLAY, or one no X server answers on (OpenCV's Qt would abort the process there): one line, exit 2."""
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    if display is None:
+        monkeypatch.delenv("DISPLAY", raising=False)
+    else:
+        monkeypatch.setenv("DISPLAY", display)
     r = run_cli("tryon", "--camera", "0", "--window")
     assert r.code == 2 and "no display" in r.err
     assert len(r.err.strip().splitlines()) == 1

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+import threading
 import time
 
 import numpy as np
@@ -32,14 +33,14 @@ class App:
         self.strokes = strokes
         self.views: dict[int, ClientView] = {}
         self.server = None
-        self.worker: WrapWorker | None = None
+        self._worker: WrapWorker | None = None
+        self._worker_lock = threading.Lock()
         self.uploads = tempfile.TemporaryDirectory(prefix="kitsuke-app-")
 
     def start(self, host: str = "127.0.0.1", port: int = 8080) -> str:
         """Listen on host:port (the next free port if it is taken); returns the URL."""
         import viser
 
-        self.worker = WrapWorker()
         self.server = viser.ViserServer(host=host, port=port, label="kitsuke", verbose=False)
         self.server.gui.configure_theme(show_share_button=False, titlebar_content=None)  # nothing goes online
         self.server.scene.set_up_direction("+y")  # kitsuke's bodies stand on Y
@@ -53,6 +54,14 @@ class App:
         return self.url
 
     @property
+    def worker(self) -> WrapWorker:
+        """The wrap worker, started at the first wrap (a tab that never wraps costs no process)."""
+        with self._worker_lock:
+            if self._worker is None:
+                self._worker = WrapWorker()
+            return self._worker
+
+    @property
     def url(self) -> str:
         host = self.server.get_host()
         return f"http://{'127.0.0.1' if host in ('0.0.0.0', '') else host}:{self.server.get_port()}"
@@ -63,8 +72,8 @@ class App:
     def stop(self) -> None:
         if self.server is not None:
             self.server.stop()
-        if self.worker is not None:
-            self.worker.close()
+        if self._worker is not None:
+            self._worker.close()
         self.uploads.cleanup()
 
 

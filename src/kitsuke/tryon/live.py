@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import os
 import queue
+import sys
 import threading
 import time
 from dataclasses import replace
@@ -50,8 +51,11 @@ class Window:
     def __init__(self, title: str = "kitsuke try-on") -> None:
         import cv2
 
-        if os.name != "nt" and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-            raise InputError(_NO_DISPLAY.format(why="DISPLAY and WAYLAND_DISPLAY are not set"))
+        if os.name != "nt" and sys.platform != "darwin":
+            # OpenCV's window is Qt on X11 (xcb): without a reachable X server Qt aborts the whole process
+            why = _x_unreachable(os.environ.get("DISPLAY", ""))
+            if why:
+                raise InputError(_NO_DISPLAY.format(why=why))
         self.title = title
         try:
             cv2.namedWindow(title, cv2.WINDOW_NORMAL)
@@ -71,6 +75,30 @@ class Window:
 
     def close(self) -> None:
         self._cv2.destroyWindow(self.title)
+
+
+def _x_unreachable(display: str) -> str | None:
+    """Why the X display cannot be reached, or None when its socket answers."""
+    import re
+    import socket
+
+    if not display:
+        return "DISPLAY is not set (OpenCV's window needs X11; under Wayland, XWayland's DISPLAY)"
+    m = re.fullmatch(r"(?P<host>[^:]*):(?P<num>\d+)(?:\.\d+)?", display)
+    if m is None:
+        return f"DISPLAY={display!r} is not a display name"
+    host, num = m["host"], int(m["num"])
+    try:
+        if host in ("", "unix"):
+            with socket.socket(socket.AF_UNIX) as s:
+                s.settimeout(1.0)
+                s.connect(f"/tmp/.X11-unix/X{num}")
+        else:
+            with socket.create_connection((host, 6000 + num), timeout=1.0):
+                pass
+    except OSError as e:
+        return f"no X server answers on DISPLAY={display} ({e.strerror or e})"
+    return None
 
 
 def mirror_view(rgb: np.ndarray, fps: float, correcting: bool) -> np.ndarray:
