@@ -213,8 +213,8 @@ def test_two_people_dress_the_larger(tmp_path, kimono, squat_frames):
     s = run.summary()
     assert s["frames_with_pose"] == 6
     assert s["registration"]["mean_px"] < 15.0  # registered to the large person (the small one would not fit)
-    if s["frames_with_several_people"]:
-        assert any("followed" in w for w in run.warnings())
+    assert s["frames_with_several_people"] >= 4  # both seen
+    assert any("followed" in w for w in run.warnings())
 
 
 def test_corrupt_images_and_a_cut_video_do_not_crash(tmp_path, kimono, squat_frames):
@@ -370,8 +370,7 @@ def test_the_person_followed_stays_until_they_leave(tmp_path, kimono, squat_fram
     run = run_tryon(_write_video(tmp_path / "leave.mp4", frames), tmp_path / "o.mp4", settings=FAST, garment=kimono)
     switched = [f.index for f in run.frames if f.switched]
     posed = [f.posed for f in run.frames]
-    if not all(posed[6:]):  # MediaPipe may not find the small person at once: then this checks nothing more
-        pytest.skip("the small person was not found in every frame")
+    assert all(posed[6:]), "the small person should be found once the large one has gone"
     assert switched and 6 <= switched[0] <= 7 and len(switched) == 1
     assert any("left 1 times" in w for w in run.warnings())
 

@@ -16,6 +16,7 @@ import numpy as np
 from ..errors import InputError
 from ..pattern import Pattern
 from ..pattern._types import EdgeRef, Piece, Seam
+from .history import History
 
 #: Two sewn edges whose lengths differ by more than this fraction get a warning (they would pucker or stretch).
 SEAM_LENGTH_TOLERANCE = 0.02
@@ -25,28 +26,20 @@ class PatternEditor:
     """A pattern being edited, with undo and redo. `pattern` is the pattern now (a new object after each change)."""
 
     def __init__(self, pattern: Pattern) -> None:
-        self.pattern = pattern
-        self._undo: list[Pattern] = []
-        self._redo: list[Pattern] = []
+        self._history = History(pattern)
+
+    @property
+    def pattern(self) -> Pattern:
+        return self._history.now
 
     def _apply(self, pattern: Pattern) -> None:
-        self._undo.append(self.pattern)
-        self._redo.clear()
-        self.pattern = pattern
+        self._history.push(pattern)
 
     def undo(self) -> bool:
-        if not self._undo:
-            return False
-        self._redo.append(self.pattern)
-        self.pattern = self._undo.pop()
-        return True
+        return self._history.undo()
 
     def redo(self) -> bool:
-        if not self._redo:
-            return False
-        self._undo.append(self.pattern)
-        self.pattern = self._redo.pop()
-        return True
+        return self._history.redo()
 
     def new(self, name: str = "garment") -> None:
         """Start from nothing: an empty pattern (undoable)."""

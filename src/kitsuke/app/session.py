@@ -19,6 +19,7 @@ import numpy as np
 from ..dressing import BodyStroke, PatternStroke, StrokePair, Strokes, in_piece_frame
 from ..errors import InputError
 from ..geometry.surface import Surface
+from .history import History
 
 #: Colours of stroke pairs, by number (the paper numbers and colours each pair); sRGB 0-255.
 PAIR_COLORS = (
@@ -46,14 +47,16 @@ class DressingSession:
         self.body = body
         self.pattern = pattern
         self.surface = Surface(body.mesh)
-        self._state = _State()
-        self._undo: list[_State] = []
-        self._redo: list[_State] = []
+        self._history = History(_State())
         self.garment = None
         if strokes is not None:
             self.load_strokes(strokes)
 
     # -- the drawing ----------------------------------------------------------------------------------------
+    @property
+    def _state(self) -> _State:
+        return self._history.now
+
     @property
     def pairs(self) -> list[StrokePair]:
         return list(self._state.pairs)
@@ -74,10 +77,8 @@ class DressingSession:
     def _change(
         self, pairs: list[StrokePair], waiting: tuple[PatternStroke, ...], garment_pairs: list | None = None
     ) -> None:
-        self._undo.append(self._state)
-        self._redo.clear()
         kept = self._state.garment_pairs if garment_pairs is None else garment_pairs
-        self._state = _State(pairs, waiting, list(kept))
+        self._history.push(_State(pairs, waiting, list(kept)))
 
     def draw_pattern_stroke(self, piece: str, points_cm: np.ndarray) -> PatternStroke:
         """A stroke on a piece, in the pattern file's coordinates (cm); it waits for its body stroke (a body
@@ -161,18 +162,10 @@ class DressingSession:
         self._change([], ())
 
     def undo(self) -> bool:
-        if not self._undo:
-            return False
-        self._redo.append(self._state)
-        self._state = self._undo.pop()
-        return True
+        return self._history.undo()
 
     def redo(self) -> bool:
-        if not self._redo:
-            return False
-        self._undo.append(self._state)
-        self._state = self._redo.pop()
-        return True
+        return self._history.redo()
 
     # -- strokes in and out ---------------------------------------------------------------------------------
     def strokes(self) -> Strokes:

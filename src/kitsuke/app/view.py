@@ -625,44 +625,40 @@ class ClientView:
         path.write_bytes(f.content)
         return path
 
+    def _opened(self, event, suffixes: tuple[str, ...], read, problem: str):  # noqa: ANN001, ANN202
+        """What `read(path)` makes of an uploaded file, or None after telling the user why not."""
+        path = self._received(event, suffixes)
+        if path is None:
+            return None
+        try:
+            return read(path)
+        except InputError as e:
+            self.notify(problem, f"{event.target.value.name}: {e.message}", "red")
+            return None
+
     def _upload_body(self, event) -> None:  # noqa: ANN001
         from ..body import load_body
 
-        path = self._received(event, BODY_SUFFIXES)
-        if path is None:
-            return
-        try:
-            body = load_body(path)
-        except InputError as e:
-            self.notify("Not a body this app can use", f"{event.target.value.name}: {e.message}", "red")
-            return
-        self._replace(body=body)
+        body = self._opened(event, BODY_SUFFIXES, load_body, "Not a body this app can use")
+        if body is not None:
+            self._replace(body=body)
 
     def _upload_pattern(self, event) -> None:  # noqa: ANN001
         from ..pattern import load_pattern
 
-        path = self._received(event, PATTERN_SUFFIXES)
-        if path is None:
-            return
-        try:
-            pattern = load_pattern(path)
-        except InputError as e:
-            self.notify("Not a pattern this app can use", f"{event.target.value.name}: {e.message}", "red")
-            return
-        self._replace(pattern=pattern)
+        pattern = self._opened(event, PATTERN_SUFFIXES, load_pattern, "Not a pattern this app can use")
+        if pattern is not None:
+            self._replace(pattern=pattern)
 
     def _upload_strokes(self, event) -> None:  # noqa: ANN001
         from ..dressing import read_strokes
 
-        path = self._received(event, (".json",))
-        if path is None:
-            return
-        try:
+        def load(path: Path) -> bool:
             self.session.load_strokes(read_strokes(path))
-        except InputError as e:
-            self.notify("Strokes not loaded", f"{event.target.value.name}: {e.message}", "red")
-            return
-        self._redraw_strokes()
+            return True
+
+        if self._opened(event, (".json",), load, "Strokes not loaded"):
+            self._redraw_strokes()
 
     def _replace(self, *, body=None, pattern=None, keep_editor: bool = False) -> None:  # noqa: ANN001
         """A new body or pattern: a fresh session, the scene rebuilt. An edited pattern keeps the stroke pairs

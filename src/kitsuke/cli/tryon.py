@@ -73,6 +73,8 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--window shows the mirror live; -o and --compare write files: run them separately")
     if args.fps is not None and not (0 < args.fps <= 1000):
         raise InputError(f"--fps must be in (0, 1000], got {args.fps}")
+    if args.max_frames is not None and args.max_frames < 1:
+        raise InputError(f"--max-frames must be at least 1, got {args.max_frames}")
     if args.edge_cm is not None and not (1.0 <= args.edge_cm <= 10.0):
         raise InputError(f"--edge-cm must be in [1, 10] cm, got {args.edge_cm}")
     source = args.camera if args.camera is not None else args.source

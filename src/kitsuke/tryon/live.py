@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import InputError
 from .frames import Latest, open_frames
 from .mirror import TryOn, TryOnSettings
-from .run import TryOnRun, _source_info
+from .run import TryOnRun, source_info
 
 #: The live mirror keeps the per-frame measures of this many last frames (counts cover all): flat memory.
 LIVE_FRAMES_KEPT = 2000
@@ -134,7 +134,7 @@ def run_live(
     settings = replace(settings or TryOnSettings(), recover=True)  # a mirror carries on: a failed kimono re-dressed
     src = open_frames(source)
     frames = Latest(src, paced=paced)
-    run = TryOnRun(_source_info(src), keep=LIVE_FRAMES_KEPT)
+    run = TryOnRun(source_info(src), keep=LIVE_FRAMES_KEPT)
     observed: queue.Queue = queue.Queue(maxsize=1)
     stop = threading.Event()
     pace = _Pace()
@@ -191,8 +191,7 @@ def run_live(
                 display.show(view)
                 if on_frame is not None:
                     on_frame(out, mirror)
-                run.add(out, frame.arrived, mirror.registrar.last.residual_px if out.posed and mirror.registrar
-                        and mirror.registrar.last is not None else None)  # fmt: skip
+                run.add(out, frame.arrived)
                 key = display.key()
                 if key == "q":
                     break

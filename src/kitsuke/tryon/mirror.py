@@ -71,7 +71,8 @@ class MirrorFrame:
     rendered). raw_image : the same with the kimono driven by the uncorrected pose (`TryOn(compare=True)`).
     people : people detected (the largest is dressed). posed : a pose was found and the kimono stepped.
     corrected : the correction rotated a leg. alpha : the kimono's opacity (below 1 while it fades out).
-    residual_px : mean registration residual (pixels), NaN when not registered. strain_max : largest edge strain
+    residual_px : mean registration residual (pixels), NaN when not registered; joint_residuals_px : (J,) per
+    joint (NaN for joints not used), None when not registered. strain_max : largest edge strain
     of the kimono. stage_s : wall time per stage, seconds. restarted : the simulation failed this frame and the
     kimono is dressed afresh on the next (`TryOnSettings.recover`). switched : the person followed left and
     another was taken (dressed afresh). raw_joints, joints : (J, 3) the filtered and the
@@ -88,6 +89,7 @@ class MirrorFrame:
     alpha: float = 0.0
     residual_px: float = float("nan")
     residual_p95_px: float = float("nan")
+    joint_residuals_px: np.ndarray | None = None
     strain_max: float = float("nan")
     stage_s: dict[str, float] = field(default_factory=dict)
     restarted: bool = False
@@ -437,6 +439,7 @@ class TryOn:
             with timer("register"):
                 reg = self.registrar(raw_posed, image)
             if reg is not None:
+                out.joint_residuals_px = reg.residual_px
                 out.residual_px = reg.mean_residual_px
                 out.residual_p95_px = float(np.nanpercentile(reg.residual_px, 95))
             out.posed = True

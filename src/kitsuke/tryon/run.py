@@ -47,7 +47,8 @@ class TryOnRun:
         self.skipped = self.dropped = 0
         self.ended: str | None = None
 
-    def add(self, frame: MirrorFrame, arrived: float, residuals: np.ndarray | None) -> None:
+    def add(self, frame: MirrorFrame, arrived: float) -> None:
+        """Count a frame that arrived at `arrived` (`time.perf_counter()`) and was output now."""
         self.latency_s.append(time.perf_counter() - arrived)
         c = self.counts
         c["frames"] += 1
@@ -56,8 +57,8 @@ class TryOnRun:
         c["corrected"] += frame.corrected
         c["restarted"] += frame.restarted
         c["switched"] += frame.switched
-        if residuals is not None:
-            r = residuals[np.isfinite(residuals)]
+        if frame.joint_residuals_px is not None:
+            r = frame.joint_residuals_px[np.isfinite(frame.joint_residuals_px)]
             self.residuals.append(r)
             self._residual_sum += float(r.sum())
             self._residual_n += len(r)
@@ -172,7 +173,8 @@ def side_by_side(raw: np.ndarray, corrected: np.ndarray) -> np.ndarray:
     return out
 
 
-def _source_info(src: FrameSource) -> dict:
+def source_info(src: FrameSource) -> dict:
+    """The report's record of a source: name, working size, fps, live."""
     return {"name": src.name, "size": list(src.size), "fps": src.fps, "live": src.live}
 
 
@@ -201,7 +203,7 @@ def run_tryon(
     from ..render.video import mp4_writer
 
     src = open_frames(source, **({"fps": fps} if fps else {}))
-    run = TryOnRun(_source_info(src))
+    run = TryOnRun(source_info(src))
     width = src.size[0] * (2 if compare else 1)
     t0 = time.perf_counter()
     if max_frames is not None and max_frames < 1:
@@ -216,8 +218,7 @@ def run_tryon(
                     out = mirror.step(frame)
                     if send is not None:
                         send(side_by_side(out.raw_image, out.image) if compare else out.image)
-                    reg = mirror.registrar.last if out.posed and np.isfinite(out.residual_px) else None
-                    run.add(out, frame.arrived, reg.residual_px if reg is not None else None)
+                    run.add(out, frame.arrived)
             except KeyboardInterrupt:
                 if not src.live:
                     raise
