@@ -136,6 +136,7 @@ def test_draw_a_stroke_pair_with_the_mouse(app_page):
 def test_wrap_in_the_browser_then_save_the_garment(app_page, tmp_path):
     """Wrap from the browser: the garment appears on the body (server scene and pixels), and the saved OBJ reads
     back as the garment."""
+    from kitsuke.dressing import drags_from_dict
     from kitsuke.dressing.export import read_garment_obj
 
     page = app_page.page
@@ -158,10 +159,26 @@ def test_wrap_in_the_browser_then_save_the_garment(app_page, tmp_path):
     # the README's picture of the app (KITSUKE_APP_SCREENSHOTS=docs pytest tests/app -k wrap rebuilds it)
     shots = Path(os.environ.get("KITSUKE_APP_SCREENSHOTS", tmp_path))
     page.screenshot(path=str(shots / "app_kimono_dressed.png"))
-    _drag_and_pin(app_page)
-    _rewrap(app_page)
     downloads = []
     page.on("download", lambda d: downloads.append(d))
+    _drag_and_pin(app_page)
+    # the drags so far as a drags file: the first drag and the pin (the second drag was undone)
+    page.get_by_role("button", name="Save drags (JSON)").click()
+    for _ in range(50):
+        if downloads:
+            break
+        page.wait_for_timeout(200)
+    assert [d.suggested_filename for d in downloads] == ["drags.json"]
+    steps = drags_from_dict(json.loads(open(downloads.pop().path()).read())).steps
+    assert [(s.grab is not None, s.pins is not None) for s in steps] == [(True, False), (False, True)]
+    # the strain map replaces the plain garment while ticked
+    page.get_by_text("Show strain").click()
+    page.wait_for_timeout(800)
+    assert view.garment_handle.visible is False
+    page.get_by_text("Show strain").click()
+    page.wait_for_timeout(300)
+    assert view.garment_handle.visible is True
+    _rewrap(app_page)
     page.get_by_role("button", name="Save garment (GLB, OBJ, report)").click()
     for _ in range(100):
         if len(downloads) == 3:
@@ -380,7 +397,7 @@ def test_editor_builds_a_skirt_that_hangs_round_the_waist(body):
     ed = _skirt_from_nothing(body)
     p = ed.pattern
     assert p.piece_names == ["piece1", "piece1_copy1"] and len(p.seams) == 2
-    assert [i for i in ed.issues() if i.startswith("error")] == []
+    assert [i.message for i in ed.issues() if i.severity == "error"] == []
     s = DressingSession(body, p)
     for piece, z, xs in (("piece1", 1, (-0.12, 0.12)), ("piece1_copy1", -1, (0.12, -0.12))):
         s.draw_pattern_stroke(piece, np.array([[15.0, 45.0], [45.0, 45.0]]))
@@ -423,8 +440,10 @@ def test_editor_undo_mirror_unsew(body):
         ed.add_piece([[0, 0], [10, 0], [20, 0]])
 
 
-def test_draw_a_piece_and_sew_in_the_browser(app_page):
-    """Click four corners on the board, close the piece, duplicate it, sew two edges by clicking them."""
+def test_a_skirt_from_nothing_in_the_browser(app_page):
+    """The issue's skirt, every step a browser gesture: click four corners on the board, close the piece,
+    duplicate it, sew the two side seams by clicking their edges, draw a stroke on each piece and one laser stroke
+    round the waist, wrap; the skirt hangs round the waist."""
     view, page = app_page.view, app_page.page
     page.get_by_text("Edit the pattern").click()
     page.get_by_role("button", name="New empty pattern").click()
@@ -457,3 +476,76 @@ def test_draw_a_piece_and_sew_in_the_browser(app_page):
     seams = view.session.pattern.seams
     assert len(seams) == 1
     assert {seams[0].a.piece, seams[0].b.piece} == {a, b}
+    for piece, pt in ((a, [0.0, h / 2]), (b, [w, h / 2])):  # and a's left side to b's right
+        px = app_page.screen(view.board.to_board(piece, np.array([pt]) + [[1.0 if piece == a else -1.0, 0]]))[0]
+        page.mouse.click(float(px[0]), float(px[1]))
+        page.wait_for_timeout(500)
+    assert len(view.session.pattern.seams) == 2
+    page.get_by_text("Sew: click two edges").click()  # off
+    # a stroke along each piece's top, the back's drawn right to left (as it lies seen from behind); one laser
+    # stroke across the waist lands on the front and the back
+    y = h - 12.0
+    app_page.drag(view.board.to_board(a, np.array([[x, y] for x in (w * 0.25, w * 0.5, w * 0.75)])))
+    app_page.drag(view.board.to_board(b, np.array([[x, y] for x in (w * 0.75, w * 0.5, w * 0.25)])))
+    page.get_by_text("Laser (front and back)").click()
+    page.wait_for_timeout(300)
+    across = _front_of_body(view.session.body, 0.0, np.array([0.95]))[0]
+    app_page.drag(np.array([across + [dx, 0, 0] for dx in (-0.1, -0.03, 0.03, 0.1)]))
+    assert len(view.session.pairs) == 2
+    page.get_by_role("button", name="Wrap", exact=True).click()
+    for _ in range(240):
+        if view.session.garment is not None and not view.busy:
+            break
+        page.wait_for_timeout(500)
+    g = view.session.garment
+    assert g is not None, "the wrap did not finish in 2 minutes"
+    lo, hi = g.positions.min(axis=0), g.positions.max(axis=0)
+    assert 0.85 < hi[1] < 1.15 and lo[1] > 0.3  # from the waist down, not to the floor
+    angle = np.degrees(np.arctan2(g.positions[:, 2] - 0.03, g.positions[:, 0]))
+    assert len(np.unique(np.floor(angle / 10))) == 36  # all the way round
+
+
+def test_edit_points_in_the_browser(app_page):
+    """Bend an edge by dragging its middle, add a point by clicking an edge, select and delete it, reverse a
+    seam: each a browser gesture, each checked on the server's pattern."""
+    view, page = app_page.view, app_page.page
+    page.get_by_text("Edit the pattern").click()
+    page.get_by_text("Edit points").click()
+    page.wait_for_timeout(800)
+    piece = view.session.pattern.piece_names[0]
+    board = view.board
+    points, middles = view.editor.handles(piece)
+    top = int(np.argmax(middles[:, 1]))  # the piece's top edge
+    start = board.to_board(piece, middles[top : top + 1])[0] + [0, 0, 0.01]
+    end = start + [0, 0.05, 0]  # 10 cm of pattern upwards
+    app_page.drag(np.array([start, start + [0, 0.02, 0], end]))
+    page.wait_for_timeout(800)
+    bent = view.session.pattern.piece(piece)
+    assert top in bent.curves
+    mid = bent.edge_points(top, np.array([0.5]))[0]
+    assert abs(mid[1] - middles[top, 1] - 10.0) < 3.0  # the middle went up about 10 cm
+    n = bent.n_edges
+    bottom = int(np.argmin(middles[:, 1]))
+    board = view.board  # laid out afresh: the piece grew taller
+    at = board.to_board(piece, bent.edge_points(bottom, np.array([0.3])))  # on the hem, a third of the way
+    px = app_page.screen(at + [0, 0.004, 0.001])[0]
+    page.mouse.click(float(px[0]), float(px[1]))
+    page.wait_for_timeout(800)
+    assert view.session.pattern.piece(piece).n_edges == n + 1
+    board = view.board
+    points = view.editor.handles(piece)[0]
+    new_point = bottom + 1  # the hem was split: its new point follows the hem's start
+    assert abs(points[new_point, 1] - bent.edge_points(bottom, np.array([0.3]))[0, 1]) < 1.0
+    px = app_page.screen(board.to_board(piece, points[new_point : new_point + 1]) + [0, 0, 0.01])
+    page.mouse.click(float(px[0, 0]), float(px[0, 1]))
+    page.wait_for_timeout(800)
+    assert view.selected_point == (piece, new_point)
+    page.get_by_role("button", name="Delete point").click()
+    page.wait_for_timeout(800)
+    assert view.session.pattern.piece(piece).n_edges == n
+    seams = view.session.pattern.seams
+    if seams:
+        before = seams[0].reversed
+        page.get_by_role("button", name="Reverse seam").click()
+        page.wait_for_timeout(800)
+        assert view.session.pattern.seams[0].reversed is (not before)

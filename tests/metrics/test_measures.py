@@ -212,3 +212,22 @@ def test_wrong_side_mm_skips_vertices_between_layers():
     # Vertex 3 has a face of layer 2 and one of layer 1: not counted as layer 1's (only vertices 1 and 4 are).
     assert len(wrong_side_mm(pos, faces, layer, 1, 2)) == 2
     assert len(wrong_side_mm(pos, faces, layer, 2, 1)) == 0
+
+
+def test_vertex_strain_is_the_worst_edge_at_each_vertex():
+    from kitsuke.app.strain_map import STOPS, strain_colors
+    from kitsuke.metrics import vertex_strain
+
+    pos = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
+    faces = np.array([[0, 1, 2], [1, 3, 2]])
+    rest = np.linalg.norm(pos[faces[:, [1, 2, 0]]] - pos[faces], axis=2)
+    assert np.allclose(vertex_strain(pos, faces, rest), 0)
+    moved = pos.copy()
+    moved[3] = [1.1, 1.0, 0]  # only edges at vertex 3 stretch: 1-3 by 0.5 %, 3-2 by 10 %
+    s = vertex_strain(moved, faces, rest)
+    assert s[0] == 0 and s[3] == pytest.approx(0.1) and s[2] == pytest.approx(0.1)
+    assert s[1] == pytest.approx(np.hypot(0.1, 1.0) - 1.0)
+    c = strain_colors(np.array([0.0, 0.05, 1.0]), 0.05)
+    assert tuple(c[0]) == STOPS[0][1] and tuple(c[1]) == STOPS[2][1] and tuple(c[2]) == STOPS[-1][1]
+    with pytest.raises(InputError):
+        vertex_strain(pos, faces, rest[:, :2])

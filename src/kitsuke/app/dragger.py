@@ -52,37 +52,36 @@ class Dragger:
 
     def _abandon(self) -> None:
         v = self.view
-        if v.dragging.grabbed is not None and v.drag_undo:
-            v.dragging.restore(v.drag_undo.pop())
-            v.dragging.grabbed = None
+        if v.dragging.grabbed is not None:
+            v.drag_history.abandon()
             v.push_positions()
         with self._cv:
             self._ops = [op for op in self._ops if op[0] == "grab"]  # the rest belonged to the failed drag
         self.busy = False
 
     def _do(self, op: str, point: np.ndarray | None) -> None:
-        v, d = self.view, self.view.dragging
+        v, d, history = self.view, self.view.dragging, self.view.drag_history
         if op == "grab":
-            v.drag_undo.append(d.snapshot())
-            v.drag_redo.clear()
-            d.grab(point)
+            history.grab(point)
             self.busy = True
+            v.show_strain()  # the plain garment while it moves
             self._t_grab = time.perf_counter()
             self.update_s.clear()
         elif op == "move" and d.grabbed is not None:
             t0 = time.perf_counter()
-            d.move_to(point)
+            history.move(point)
             v.push_positions()
             self._t_last = time.perf_counter()
             self.update_s.append(self._t_last - t0)
         elif op == "release" and d.grabbed is not None:
             note = v.client.add_notification("Settling", "the cloth after the drag", loading=True)
             try:
-                d.release()
+                history.release()
             finally:
                 note.remove()
             v.push_positions()
             self.busy = False
+            v.show_strain()
             n = len(self.update_s)
             if n:
                 rate = n / max(self._t_last - self._t_grab, 1e-9)  # while dragging (the release apart)

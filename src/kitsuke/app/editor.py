@@ -6,7 +6,11 @@ editor = PatternEditor(Pattern("skirt"))
 front = editor.add_piece([[0, 0], [60, 0], [60, 55], [0, 55]])    # corners, cm; any winding
 back = editor.duplicate(front)
 editor.sew(EdgeRef(front, 1), EdgeRef(back, 3))                    # -> a warning when the lengths differ > 2 %
+editor.curve_edge(front, 2, [30, 60])                              # edge 2's middle now passes through (30, 60)
+editor.insert_point(front, 0, [30, 0]); editor.move_point(front, 1, [30, -3])
 editor.issues()                                                    # what `kitsuke pattern validate` would say
+
+Points and edges are those of the piece's own outline (cm, counter-clockwise): edge i runs from point i to i + 1.
 """
 
 from __future__ import annotations
@@ -15,8 +19,14 @@ import numpy as np
 
 from ..errors import InputError
 from ..pattern import Pattern
-from ..pattern._types import EdgeRef, Piece, Seam
+from ..pattern import _geometry as geo
+from ..pattern._types import Curve, EdgeRef, Piece, Seam
 from .history import History
+
+#: An edge whose middle lies closer than this fraction of its length to its chord is made straight.
+STRAIGHT_FRACTION = 0.01
+#: Samples along an edge when finding the point of it nearest a click.
+EDGE_SAMPLES = 400
 
 #: Two sewn edges whose lengths differ by more than this fraction get a warning (they would pucker or stretch).
 SEAM_LENGTH_TOLERANCE = 0.02
@@ -131,6 +141,129 @@ class PatternEditor:
                 best, best_d = e, d
         return best
 
+    def edge_parameter(self, piece: str, edge: int, point_cm) -> float:  # noqa: ANN001
+        """The curve parameter t in [0, 1] of the point of an edge nearest `point_cm` (piece cm)."""
+        t = np.linspace(0.0, 1.0, EDGE_SAMPLES + 1)
+        pts = self.pattern.piece(piece).edge_points(edge, t)
+        return float(t[np.argmin(np.linalg.norm(pts - np.asarray(point_cm, dtype=np.float64), axis=1))])
+
+    def handles(self, piece: str) -> tuple[np.ndarray, np.ndarray]:
+        """Where a piece is edited: its points (n, 2) and its edges' middles (n, 2) (t = 0.5 on each), cm."""
+        pc = self.pattern.piece(piece)
+        return pc.outline.copy(), np.array([pc.edge_points(e, np.array([0.5]))[0] for e in range(pc.n_edges)])
+
+    def move_point(self, piece: str, index: int, to_cm) -> str | None:  # noqa: ANN001
+        """Move one point of a piece's outline (its two edges keep their curves, relative to their ends). Returns a
+        warning when a seam on those edges now joins lengths that differ by more than the tolerance."""
+        p = self.pattern.copy()
+        k = p.piece_index(piece)
+        src = p.pieces[k]
+        out = src.outline.copy()
+        out[index % src.n_edges] = np.asarray(to_cm, dtype=np.float64)
+        p.pieces[k] = Piece(src.name, out, dict(src.curves), src.flipped, src.placement)
+        self._apply(p)
+        n = src.n_edges
+        return self._seam_length_warning({EdgeRef(piece, (index - 1) % n), EdgeRef(piece, index % n)})
+
+    def curve_edge(self, piece: str, edge: int, through_cm) -> None:  # noqa: ANN001
+        """Bend an edge so that its middle (t = 0.5) passes through a point (cm): the handle drag of a drawing
+        editor. A straight edge becomes a quadratic curve; a curved one keeps its kind; through the chord's middle,
+        it becomes straight."""
+        p = self.pattern.copy()
+        k = p.piece_index(piece)
+        src = p.pieces[k]
+        edge %= src.n_edges
+        a, b = src.edge_endpoints(edge)
+        target = np.asarray(through_cm, dtype=np.float64)
+        curves = dict(src.curves)
+        if abs(float(geo.abs_to_rel(a, b, target)[0, 1])) < STRAIGHT_FRACTION:
+            curves.pop(edge, None)
+        else:
+            old = curves.get(edge)
+            shift = target - src.edge_points(edge, np.array([0.5]))[0]
+            if old is None:  # B(1/2) = (a + 2c + b) / 4
+                curves[edge] = Curve("quadratic", geo.abs_to_rel(a, b, 2.0 * target - 0.5 * (a + b)))
+            elif old.type == "circle":  # the control point is the arc's middle itself
+                curves[edge] = Curve("circle", [[0.5, float(geo.abs_to_rel(a, b, target)[0, 1])]])
+            else:  # B(1/2) moves by 1/2 (quadratic) or 3/4 (cubic) of a shift of every control point
+                ctrl = geo.rel_to_abs(a, b, old.control) + shift / (0.5 if old.type == "quadratic" else 0.75)
+                curves[edge] = Curve(old.type, geo.abs_to_rel(a, b, ctrl))
+        p.pieces[k] = Piece(src.name, src.outline.copy(), curves, src.flipped, src.placement)
+        self._apply(p)
+
+    def insert_point(self, piece: str, edge: int, at_cm) -> str | None:  # noqa: ANN001
+        """Split an edge at the point of it nearest `at_cm` (a curve splits into two curves of the same shape).
+        A seam on that edge is removed, and said in the returned warning (a seam joins whole edges)."""
+        t = self.edge_parameter(piece, edge, at_cm)
+        if not 0.02 < t < 0.98:
+            raise InputError("that is a corner already: click nearer the middle of the edge to add a point")
+        p = self.pattern.copy()
+        k = p.piece_index(piece)
+        src = p.pieces[k]
+        edge %= src.n_edges
+        c = src.curves.get(edge)
+        mid, first, second = geo.split_curve(*src.edge_endpoints(edge), c and c.type, c and c.control, t)
+        curves = {(e + (e > edge)): cv for e, cv in src.curves.items() if e != edge}
+        for e, ctrl in ((edge, first), (edge + 1, second)):
+            if ctrl is not None:
+                curves[e] = Curve(c.type, ctrl)
+        out = np.insert(src.outline, edge + 1, mid, axis=0)
+        p.pieces[k] = Piece(src.name, out, curves, src.flipped, src.placement)
+        dropped = self._renumber(p, piece, {edge}, lambda e: e + (e > edge))
+        self._apply(p)
+        return dropped
+
+    def delete_point(self, piece: str, index: int) -> str | None:
+        """Remove one point of a piece's outline: its two edges become one straight edge. Seams on either are
+        removed, and said in the returned warning. InputError: a piece keeps at least 3 points."""
+        p = self.pattern.copy()
+        k = p.piece_index(piece)
+        src = p.pieces[k]
+        n = src.n_edges
+        if n <= 3:
+            raise InputError(f"piece {piece!r} has 3 points, the fewest a piece can have")
+        i = index % n
+        merged = {(i - 1) % n, i}
+        curves = {(e - (e > i)): cv for e, cv in src.curves.items() if e not in merged}
+        p.pieces[k] = Piece(src.name, np.delete(src.outline, i, axis=0), curves, src.flipped, src.placement)
+        dropped = self._renumber(p, piece, merged, lambda e: e - (e > i))
+        self._apply(p)
+        return dropped
+
+    @staticmethod
+    def _renumber(p: Pattern, piece: str, gone: set[int], new_index) -> str | None:  # noqa: ANN001
+        """Seams after an outline edit: those on edges in `gone` removed, the others' edges renumbered (in place).
+        Returns the warning that names the removed seams, or None."""
+        kept, removed = [], []
+        for s in p.seams:
+            if any(r.piece == piece and r.edge in gone for r in (s.a, s.b)):
+                removed.append(f"{s.a}–{s.b}")
+                continue
+            a, b = (EdgeRef(r.piece, new_index(r.edge)) if r.piece == piece else r for r in (s.a, s.b))
+            kept.append(Seam(a, b, s.reversed))
+        p.seams = kept
+        return f"seam {', '.join(removed)} removed: its edge changed (sew it again)" if removed else None
+
+    def _seam_length_warning(self, edges: set[EdgeRef]) -> str | None:
+        for s in self.pattern.seams:
+            if s.a in edges or s.b in edges:
+                la, lb = self.pattern.edge_length(s.a), self.pattern.edge_length(s.b)
+                diff = abs(la - lb) / max(la, lb)
+                if diff > SEAM_LENGTH_TOLERANCE:
+                    return f"edges {s.a} and {s.b} differ in length by {100 * diff:.0f} % ({la:.1f} and {lb:.1f} cm)"
+        return None
+
+    def reverse_seam(self, edge: EdgeRef) -> None:
+        """Turn the seam on an edge round: a's start then meets b's start instead of b's end (a twisted seam
+        undone, or made). InputError when the edge is not sewn."""
+        p = self.pattern.copy()
+        for k, s in enumerate(p.seams):
+            if edge in (s.a, s.b):
+                p.seams[k] = Seam(s.a, s.b, not s.reversed)
+                self._apply(p)
+                return
+        raise InputError(f"edge {edge} is not sewn")
+
     def sew(self, a: EdgeRef, b: EdgeRef) -> str | None:
         """Sew two edges (a's start to b's end, as two pieces facing out meet). Returns a warning when their
         lengths differ by more than `SEAM_LENGTH_TOLERANCE`, else None. InputError: an edge sewn to itself, or
@@ -141,14 +274,10 @@ class PatternEditor:
             for r in (a, b):
                 if r in (s.a, s.b):
                     raise InputError(f"edge {r} is already sewn (unsew it first)")
-        la, lb = self.pattern.edge_length(a), self.pattern.edge_length(b)
         p = self.pattern.copy()
         p.seams.append(Seam(a, b, True))
         self._apply(p)
-        diff = abs(la - lb) / max(la, lb)
-        if diff > SEAM_LENGTH_TOLERANCE:
-            return f"edges {a} and {b} differ in length by {100 * diff:.0f} % ({la:.1f} and {lb:.1f} cm)"
-        return None
+        return self._seam_length_warning({a})
 
     def unsew(self, edge: EdgeRef) -> None:
         """Remove the seam on an edge. InputError when the edge is not sewn."""
@@ -159,9 +288,8 @@ class PatternEditor:
         p.seams = kept
         self._apply(p)
 
-    def issues(self) -> list[str]:
-        """What `kitsuke pattern validate` says of the pattern now: errors first, one line each."""
+    def issues(self) -> list:
+        """What `kitsuke pattern validate` says of the pattern now (`Issue`s), errors first."""
         from ..pattern import validate
 
-        found = sorted(validate(self.pattern), key=lambda i: i.severity != "error")
-        return [f"{i.severity}: {i.message}" for i in found]
+        return sorted(validate(self.pattern), key=lambda i: i.severity != "error")

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..errors import ComputationError, InputError
 from .board import BoardLayout
+from .drag_history import DragHistory
 from .dragger import Dragger
 from .editor import PatternEditor
 from .session import DressingSession, pair_color
@@ -35,6 +36,8 @@ GARMENT_COLOR = (70, 95, 160)
 PIECE_COLOR = (246, 240, 228)
 BODY_SUFFIXES = (".obj", ".glb", ".gltf", ".ply")
 PATTERN_SUFFIXES = (".json", ".svg")
+#: A handle dragged less than this (board metres) stays where it was: a click that shook.
+CLICK_SLOP_M = 0.004
 
 
 @dataclass
@@ -56,11 +59,12 @@ class ClientView:
         self.board = BoardLayout.of(app.pattern)
         self.corners: list[np.ndarray] = []  # a piece being drawn, corner by corner (board metres)
         self.sewing: list = []  # the first edge picked for a seam
+        self.selected_point: tuple[str, int] | None = None  # (piece, point index) in point mode
         self.drawing: _Drawing | None = None
         self.cancel = threading.Event()
         self.busy = False
-        self._build_scene()
         self._build_panel()
+        self._build_scene()
         self._redraw_strokes()
         client.scene.on_click()(self._on_scene_click)  # corners of a piece being drawn (once: scenes are rebuilt)
 
@@ -100,20 +104,67 @@ class ClientView:
             top = self.board.to_board(name, np.array([[(low[0] + high[0]) / 2, high[1]]]))[0]
             scene.add_label(f"/board/{name}/name", name, position=tuple(top + [0, 0.03, 0]), anchor="bottom-center")
         self._draw_seams()
+        self._draw_problems()
+        self._draw_handles()
 
     def _draw_seams(self) -> None:
-        """Each seam as thin lines between its two edges' midpoints, numbered."""
+        """Each seam as two lines, numbered: from near a's start to the point of b it meets, and from near a's
+        end to its match. A twisted seam shows as two lines that cross."""
         pattern = self.session.pattern
-        segments = []
-        for seam in pattern.seams:
-            a = pattern.piece(seam.a.piece).edge_points(seam.a.edge, np.array([0.5]))
-            b = pattern.piece(seam.b.piece).edge_points(seam.b.edge, np.array([0.5]))
-            segments.append([self.board.to_board(seam.a.piece, a)[0], self.board.to_board(seam.b.piece, b)[0]])
+        segments, colors = [], []
+        for k, seam in enumerate(pattern.seams):
+            t = np.array([0.15, 0.85])
+            a = self.board.to_board(seam.a.piece, pattern.piece(seam.a.piece).edge_points(seam.a.edge, t))
+            b = self.board.to_board(
+                seam.b.piece, pattern.piece(seam.b.piece).edge_points(seam.b.edge, 1 - t if seam.reversed else t)
+            )
+            segments += [[a[0], b[0]], [a[1], b[1]]]
+            colors += [pair_color(k + 1)] * 2
+            mid = (a.mean(axis=0) + b.mean(axis=0)) / 2 + [0, 0, 0.005]
+            self.client.scene.add_label(f"/board/seam_labels/{k}", f"seam {k}", position=tuple(mid))
         if segments:
             pts = np.array(segments) + [0, 0, 0.004]
+            cols = np.repeat(np.array(colors, dtype=np.uint8)[:, None], 2, axis=1)
             self.seam_handle = self.client.scene.add_line_segments(
-                "/board/seams", pts, (150, 150, 220), thickness=1.0, thickness_units="screen"
+                "/board/seams", pts, cols, thickness=2.0, thickness_units="screen"
             )
+
+    def _draw_problems(self) -> None:
+        """The pattern's errors where they are: the edges at fault drawn red on their piece, with the message."""
+        for k, issue in enumerate(i for i in self.editor.issues() if i.severity == "error" and i.piece):
+            if issue.piece not in self.board.places:
+                continue
+            piece = self.session.pattern.piece(issue.piece)
+            edges = issue.edges or tuple(range(piece.n_edges))
+            for e in edges:
+                pts = self.board.to_board(issue.piece, piece.sample_edge(e)) + [0, 0, 0.005]
+                self.client.scene.add_line_segments(
+                    f"/board/problems/{k}/{e}", np.stack([pts[:-1], pts[1:]], axis=1), (220, 30, 30),
+                    thickness=5.0, thickness_units="screen",
+                )  # fmt: skip
+            low, high = piece.bounds
+            at = self.board.to_board(issue.piece, np.array([(low + high) / 2]))[0] + [0, 0, 0.01]
+            self.client.scene.add_label(f"/board/problems/{k}/label", issue.message, position=tuple(at))
+
+    def _draw_handles(self) -> None:
+        """In point mode: each piece's points (drag to move, click to select) and its edges' middles (drag to
+        bend the edge)."""
+        if not self.point_mode.value:
+            return
+        r = 0.012  # metres on the board: 2.4 cm of pattern
+        for name in self.session.pattern.piece_names:
+            points, middles = self.editor.handles(name)
+            for kind, pts, color in (("point", points, (150, 30, 30)), ("middle", middles, (30, 90, 200))):
+                on_board = self.board.to_board(name, pts) + [0, 0, 0.01]
+                for i, at in enumerate(on_board):
+                    selected = kind == "point" and self.selected_point == (name, i)
+                    h = self.client.scene.add_icosphere(
+                        f"/board/handles/{name}/{kind}{i}", r * (1.5 if selected else 1.0),
+                        (250, 180, 0) if selected else color, position=tuple(at), subdivisions=1,
+                    )  # fmt: skip
+                    h.on_drag()(self._handle_drag(name, kind, i))
+                    if kind == "point":
+                        h.on_click()(self._point_clicked(name, i))
 
     def _redraw_strokes(self) -> None:
         scene = self.client.scene
@@ -253,6 +304,16 @@ class ClientView:
             self.piece_mode = gui.add_checkbox("Draw a piece: click its corners", False)
             gui.add_button("Close the piece").on_click(lambda _: self._close_piece())
             self.sew_mode = gui.add_checkbox("Sew: click two edges", False)
+            self.point_mode = gui.add_checkbox(
+                "Edit points", False,
+                hint="drag a red point to move it, a blue one to bend its edge; click an edge to add a point there, "
+                "click a point to select it for Delete point",
+            )  # fmt: skip
+            self.point_mode.on_update(lambda _: self._rebuild_scene())
+            gui.add_button("Delete point").on_click(lambda _: self._delete_point())
+            self.seam_choice = gui.add_dropdown("Seam", self._seam_names())
+            gui.add_button("Reverse seam").on_click(lambda _: self._seam_action(self.editor.reverse_seam))
+            gui.add_button("Unsew").on_click(lambda _: self._seam_action(self.editor.unsew))
             gui.add_button("Duplicate piece").on_click(
                 lambda _: self._edit_pattern(lambda: self.editor.duplicate(self.flip_choice.value))
             )
@@ -285,6 +346,12 @@ class ClientView:
             gui.add_button("Unpin all").on_click(lambda _: self._unpin_all())
             gui.add_button("Undo drag").on_click(lambda _: self._drag_history(undo=True))
             gui.add_button("Redo drag").on_click(lambda _: self._drag_history(undo=False))
+            self.strain_box = gui.add_checkbox(
+                "Show strain",
+                False,
+                hint="the garment coloured by stretch: yellow at the quality target, red at twice it",
+            )
+            self.strain_box.on_update(lambda _: self.show_strain())
             self.drag_rate = gui.add_markdown("Wrap first; then press and drag on the garment.")
         with gui.add_folder("Files"):
             gui.add_upload_button("Open body (OBJ, GLB, PLY)").on_upload(self._upload_body)
@@ -292,11 +359,11 @@ class ClientView:
             gui.add_upload_button("Open strokes (JSON)").on_upload(self._upload_strokes)
             gui.add_button("Save strokes").on_click(lambda _: self._download_strokes())
             gui.add_button("Save garment (GLB, OBJ, report)").on_click(lambda _: self._download_garment())
+            gui.add_button("Save drags (JSON)").on_click(lambda _: self._download_drags())
 
     def _unpin_all(self) -> None:
         if getattr(self, "dragging", None) is not None and not self.dragger.busy:
-            self.drag_undo.append(self.dragging.snapshot())
-            self.dragging.unpin(all=True)
+            self.drag_history.unpin_all()
             self._show_pins()
 
     def _show_seams(self, on: bool) -> None:
@@ -310,9 +377,65 @@ class ClientView:
         except InputError as e:
             self.notify("Not done", e.message, "red")
             return
-        if isinstance(warning, str) and " differ in length" in warning:
-            self.notify("Sewn, but", warning, "yellow")
+        if isinstance(warning, str):  # a length mismatch, or a seam an edit removed
+            self.notify("Done, but", warning, "yellow")
         self._replace(pattern=self.editor.pattern, keep_editor=True)
+
+    def _rebuild_scene(self) -> None:
+        self.client.scene.reset()
+        self._build_scene()
+        self._redraw_strokes()
+
+    def _seam_names(self) -> list[str]:
+        names = [f"{k}: {s.a} to {s.b}" for k, s in enumerate(self.session.pattern.seams)]
+        return names or ["(no seams)"]
+
+    def _seam_action(self, action) -> None:  # noqa: ANN001 - an editor call on one edge of the seam
+        seams = self.editor.pattern.seams
+        k = int(self.seam_choice.value.split(":")[0]) if self.seam_choice.value[0].isdigit() else -1
+        if not 0 <= k < len(seams):
+            self.notify("No seam chosen", "Sew two edges first (Sew: click two edges).", "yellow")
+            return
+        self._edit_pattern(lambda: action(seams[k].a))
+
+    def _handle_drag(self, piece: str, kind: str, index: int):  # noqa: ANN202
+        """A point handle moves the point; an edge's middle handle bends the edge (applied on release)."""
+        pressed: list[np.ndarray] = []
+
+        async def handler(event) -> None:  # noqa: ANN001
+            hit = self.board.on_board(*self._ray(event))
+            if hit is None:
+                return
+            if event.phase == "start":
+                pressed[:] = [hit]
+                return
+            event.target.position = tuple(hit + [0, 0, 0.01])  # follows the pointer while dragged
+            if event.phase != "end":
+                return
+            if pressed and np.linalg.norm(hit - pressed[0]) < CLICK_SLOP_M:  # a shaky click: nothing moves
+                self._rebuild_scene()
+                return
+            cm = self.board.to_piece(piece, hit[None])[0]
+            if kind == "point":
+                self._edit_pattern(lambda: self.editor.move_point(piece, index, cm))
+            else:
+                self._edit_pattern(lambda: self.editor.curve_edge(piece, index, cm))
+
+        return handler
+
+    def _point_clicked(self, piece: str, index: int):  # noqa: ANN202
+        def handler(_event) -> None:  # noqa: ANN001
+            self.selected_point = None if self.selected_point == (piece, index) else (piece, index)
+            self._rebuild_scene()
+
+        return handler
+
+    def _delete_point(self) -> None:
+        if self.selected_point is None:
+            self.notify("No point selected", "Tick Edit points and click a red point first.", "yellow")
+            return
+        (piece, index), self.selected_point = self.selected_point, None
+        self._edit_pattern(lambda: self.editor.delete_point(piece, index))
 
     def _on_scene_click(self, event) -> None:  # noqa: ANN001
         """A corner of the piece being drawn, where the click's ray meets the board."""
@@ -350,14 +473,18 @@ class ClientView:
 
     def _piece_click_handler(self, piece: str):  # noqa: ANN202
         def handler(event) -> None:  # noqa: ANN001
-            if not self.sew_mode.value:
+            if not (self.sew_mode.value or self.point_mode.value):
                 return
             hit = self.board.on_board(np.asarray(event.ray_origin), np.asarray(event.ray_direction))
             if hit is None:
                 return
             from ..pattern._types import EdgeRef
 
-            edge = EdgeRef(piece, self.editor.nearest_edge(piece, self.board.to_piece(piece, hit[None])[0]))
+            cm = self.board.to_piece(piece, hit[None])[0]
+            edge = EdgeRef(piece, self.editor.nearest_edge(piece, cm))
+            if self.point_mode.value:
+                self._edit_pattern(lambda: self.editor.insert_point(piece, edge.edge, cm))
+                return
             if not self.sewing:
                 self.sewing = [edge]
                 self._status(f"Edge {edge} picked: click the edge to sew it to.")
@@ -491,8 +618,7 @@ class ClientView:
         from ..dressing import DragSession
 
         self.dragging = DragSession(self.session.body, garment)
-        self.drag_undo: list = []
-        self.drag_redo: list = []
+        self.drag_history = DragHistory(self.dragging)
         self.dragger = Dragger(self)
         self._show_garment()
 
@@ -507,6 +633,30 @@ class ClientView:
         self.garment_handle.on_click()(self._on_garment_click)
         self._shown_vertices = d.n_vertices
         self._show_pins()
+        self.show_strain()
+
+    def show_strain(self) -> None:
+        """The strain map in place of the plain garment while it is at rest and Show strain is ticked (a drag
+        shows the plain garment: only its vertices stream)."""
+        import trimesh
+
+        from ..metrics import QualityTargets, vertex_strain
+        from .strain_map import strain_colors
+
+        d = getattr(self, "dragging", None)
+        if d is None:
+            return
+        on = self.strain_box.value and d.grabbed is None
+        if on:
+            g = d.garment()
+            colors = strain_colors(
+                vertex_strain(g.positions, g.faces, g.rest_edge_lengths), QualityTargets().max_strain
+            )
+            mesh = trimesh.Trimesh(g.positions, g.faces, vertex_colors=colors, process=False)
+            self.client.scene.add_mesh_trimesh("/garment_strain", mesh)
+        else:
+            self.client.scene.remove_by_name("/garment_strain")
+        self.garment_handle.visible = not on
 
     def _show_pins(self) -> None:
         d = self.dragging
@@ -581,25 +731,16 @@ class ClientView:
         hit = cloth.cast(np.asarray(event.ray_origin)[None], np.asarray(event.ray_direction)[None], hit="first")
         if not hit.hit.all():
             return
-        v = int(d.model.faces[hit.faces[0]][np.argmax(hit.barycentric[0])])
-        self.drag_undo.append(d.snapshot())
-        self.drag_redo.clear()
-        if d.pinned[v]:
-            d.unpin(vertices=[v])
-        else:
-            d.pin(vertices=[v])
+        self.drag_history.toggle_pin(int(d.model.faces[hit.faces[0]][np.argmax(hit.barycentric[0])]))
         self._show_pins()
 
     def _drag_history(self, undo: bool) -> None:
         if getattr(self, "dragging", None) is None or self.dragger.busy:
             return
-        src, dst = (self.drag_undo, self.drag_redo) if undo else (self.drag_redo, self.drag_undo)
-        if not src:
-            return
-        dst.append(self.dragging.snapshot())
-        self.dragging.restore(src.pop())
-        self.push_positions()
-        self._show_pins()
+        if self.drag_history.undo() if undo else self.drag_history.redo():
+            self.push_positions()
+            self._show_pins()
+            self.show_strain()
 
     def _job_ended(self, note, ticking: threading.Event, title: str, body: str, color: str) -> None:  # noqa: ANN001
         ticking.set()
@@ -681,8 +822,9 @@ class ClientView:
             self.flip_choice.options = names
             self.flip_choice.value = current if current in names else names[-1]
         if hasattr(self, "issues_md"):
-            found = self.editor.issues()
+            found = [f"{i.severity}: {i.message}" for i in self.editor.issues()]
             self.issues_md.content = "\n\n".join(found[:6]) if found else "No problems found in the pattern."
+            self.seam_choice.options = self._seam_names()
         self._redraw_strokes()
 
     def _download_strokes(self) -> None:
@@ -690,6 +832,17 @@ class ClientView:
 
         self.client.send_file_download(
             "strokes.json", strokes_to_json(self.session.strokes()).encode(), save_immediately=True
+        )
+
+    def _download_drags(self) -> None:
+        """The pins and drags made so far, as a drags file that `kitsuke drag --drags` replays."""
+        from ..dressing import drags_to_json
+
+        if getattr(self, "dragging", None) is None:
+            self.notify("Nothing dressed yet", "Wrap, pin and drag first, then save the drags.", "yellow")
+            return
+        self.client.send_file_download(
+            "drags.json", drags_to_json(self.drag_history.drags()).encode(), save_immediately=True
         )
 
     def _download_garment(self) -> None:

@@ -16,6 +16,7 @@ from ._measures import (
     penetration,
     seam_gap,
     strain,
+    vertex_strain,
 )
 from ._report import QualityReport, QualityTargets, quality_report
 
@@ -33,5 +34,6 @@ __all__ = [
     "quality_report",
     "seam_gap",
     "strain",
+    "vertex_strain",
     "wrong_side_mm",
 ]

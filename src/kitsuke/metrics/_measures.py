@@ -206,3 +206,20 @@ def inverted_triangles(positions: np.ndarray, faces: np.ndarray, *, rest_areas: 
             raise InputError(f"rest_areas must have shape ({len(f)},), got {ra.shape}")
         collapsed = 0.5 * area2 < COLLAPSE_RATIO * ra
     return folded | collapsed
+
+
+def vertex_strain(positions: np.ndarray, faces: np.ndarray, rest_edge_lengths: np.ndarray) -> np.ndarray:
+    """(V,) float64: the largest strain (|length / rest - 1|) of the triangle edges at each vertex, for strain
+    maps. positions (V, 3) metres; faces (F, 3); rest_edge_lengths (F, 3) metres, edges 0-1, 1-2, 2-0."""
+    pos = _points(positions, "positions")
+    f = _faces(faces, len(pos))
+    rest = np.asarray(rest_edge_lengths, dtype=np.float64)
+    if rest.shape != f.shape:
+        raise InputError(f"rest_edge_lengths must have shape {f.shape}, got {rest.shape}")
+    length = np.linalg.norm(pos[f[:, [1, 2, 0]]] - pos[f], axis=2)
+    s = np.abs(length / np.maximum(rest, 1e-12) - 1.0)  # (F, 3): edge k runs from corner k to k + 1
+    out = np.zeros(len(pos))
+    for k in range(3):
+        np.maximum.at(out, f[:, k], s[:, k])
+        np.maximum.at(out, f[:, (k + 1) % 3], s[:, k])
+    return out

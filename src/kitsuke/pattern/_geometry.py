@@ -265,3 +265,29 @@ def matrix_to_euler_xyz(m: np.ndarray) -> np.ndarray:
         if best is None or np.abs(deg).sum() < np.abs(best).sum() - 1e-9:
             best = deg
     return best
+
+
+def split_curve(
+    p0: np.ndarray, p1: np.ndarray, kind: str | None, control: np.ndarray | None, t: float
+) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+    """Split the edge p0 -> p1 at parameter t in (0, 1): the point there (2,) and each half's relative control
+    points (None for a straight half). Béziers split by de Casteljau; an arc into two arcs of the same circle."""
+    mid = curve_points(p0, p1, kind, control, np.array([t]))[0]
+    if _is_straight(kind, control):
+        return mid, None, None
+    if kind == "circle":
+        _, radius, _, sweep = _arc_geometry(p0, p1, float(control[0, 1]))
+
+        def half(part: float) -> np.ndarray:
+            phi = abs(sweep) * part  # the half's own sweep: chord 2 r sin(phi/2), sagitta r (1 - cos(phi/2))
+            y = (1.0 - math.cos(0.5 * phi)) / (2.0 * math.sin(0.5 * phi))
+            return np.array([[0.5, math.copysign(y, float(control[0, 1]))]])
+
+        return mid, half(t), half(1.0 - t)
+    c = rel_to_abs(p0, p1, control)
+    if kind == "quadratic":
+        a, b = p0 + t * (c[0] - p0), c[0] + t * (p1 - c[0])
+        return mid, abs_to_rel(p0, mid, a), abs_to_rel(mid, p1, b)
+    ab, bc, cd = p0 + t * (c[0] - p0), c[0] + t * (c[1] - c[0]), c[1] + t * (p1 - c[1])
+    abc, bcd = ab + t * (bc - ab), bc + t * (cd - bc)
+    return mid, abs_to_rel(p0, mid, np.stack([ab, abc])), abs_to_rel(mid, p1, np.stack([bcd, cd]))

@@ -46,6 +46,7 @@ class Issue:
     message : one line for people.
     piece : the piece concerned, if one.
     seam : index of the seam concerned, if one.
+    edges : the edges of `piece` at fault (a crossing's two edges, a zero-length edge), for showing on the piece.
     """
 
     severity: Literal["error", "warning"]
@@ -53,6 +54,7 @@ class Issue:
     message: str
     piece: str | None = None
     seam: int | None = None
+    edges: tuple[int, ...] = ()
 
     def to_dict(self) -> dict:
         d = {"severity": self.severity, "code": self.code, "message": self.message}
@@ -60,6 +62,8 @@ class Issue:
             d["piece"] = self.piece
         if self.seam is not None:
             d["seam"] = self.seam
+        if self.edges:
+            d["edges"] = list(self.edges)
         return d
 
 
@@ -71,7 +75,13 @@ def _piece_issues(piece) -> list[Issue]:
     size = float(np.ptp(pts, axis=0).max())
     for i in np.flatnonzero(step <= 1e-9 * max(size, 1.0)):
         out.append(
-            Issue("error", "zero-length-edge", f"piece {name!r}: edge {i} has zero length (repeated point)", name)
+            Issue(
+                "error",
+                "zero-length-edge",
+                f"piece {name!r}: edge {i} has zero length (repeated point)",
+                name,
+                edges=(int(i),),
+            )
         )
     if out:
         return out  # the geometry below would be meaningless
@@ -81,7 +91,10 @@ def _piece_issues(piece) -> list[Issue]:
     if hit is not None:
         edges = sorted({int(edge_of[hit[0]]), int(edge_of[hit[1]])})
         where = f"edges {edges[0]} and {edges[1]}" if len(edges) == 2 else f"edge {edges[0]}"
-        out.append(Issue("error", "self-intersection", f"piece {name!r}: outline crosses itself ({where})", name))
+        out.append(
+            Issue("error", "self-intersection", f"piece {name!r}: outline crosses itself ({where})", name,
+                  edges=tuple(edges))
+        )  # fmt: skip
     elif abs(area) <= ZERO_AREA_FRACTION * size * size:
         out.append(Issue("error", "zero-area", f"piece {name!r}: outline has zero area", name))
     elif area < 0:
