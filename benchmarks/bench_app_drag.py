@@ -9,7 +9,8 @@ is opened in headless Chromium and the mouse drags the kimono's front up and dow
 16 ms (60 Hz). Measured: the drag events viser delivered, the updates the server computed and sent (each a
 `DragSession.move_to` and the garment's vertices sent to the browser; a newer pointer position replaces one not
 yet computed), their time, and the release's. The browser shows each update when it arrives; its frame time
-under software WebGL is not included.
+under software WebGL is not included. Then the server alone: pointer positions submitted at 60 Hz from Python
+(as a browser that keeps up would send them), each update computed and sent to the open tab.
 """
 
 from __future__ import annotations
@@ -87,6 +88,26 @@ def main() -> None:
             time.sleep(0.05)
         release_s = time.perf_counter() - t_up
         upd = np.array(view.dragger.update_s)
+        # the server alone: pointer positions submitted at 60 Hz from here (as the browser would on a machine that
+        # keeps up), each update computed and sent to the connected tab
+        view.dragger.submit = submit
+        body_pts = Surface(view.session.body.mesh)
+        start = body_pts.closest((d.positions[d.vertices_at(start[None])[0]])[None]).points[0]
+        submit("grab", start)
+        t1 = time.perf_counter()
+        k = 0
+        while time.perf_counter() - t1 < args.seconds:
+            s = 0.5 - 0.5 * np.cos(2 * np.pi * k / 120)
+            submit("move", body_pts.closest((start + [0, 0.12 * s, 0])[None]).points[0])
+            k += 1
+            time.sleep(1 / 60)
+        server_s = time.perf_counter() - t1
+        while view.dragger._ops and view.dragger._ops[0][0] == "move":
+            time.sleep(0.01)
+        server_upd = np.array(view.dragger.update_s)
+        submit("release", None)
+        while view.dragger.busy or view.dragger._ops:
+            time.sleep(0.05)
         out = {
             "garment_vertices": int(len(garment.positions)),
             "mouse_moves": k,
@@ -97,6 +118,8 @@ def main() -> None:
             "update_ms_median": round(float(np.median(upd)) * 1e3, 1),
             "update_ms_p95": round(float(np.percentile(upd, 95)) * 1e3, 1),
             "release_s": round(release_s, 2),
+            "server_alone_updates_per_s": round(len(server_upd) / server_s, 1),
+            "server_alone_update_ms_median": round(float(np.median(server_upd)) * 1e3, 1),
             "machine": {"cores": os.cpu_count(), "processor": platform.processor(), "load": os.getloadavg()},
         }
         print(json.dumps(out, indent=1))
