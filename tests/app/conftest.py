@@ -56,9 +56,17 @@ class AppPage:
                 raise TimeoutError("the page never connected to the app")
             time.sleep(0.1)
         self.page.wait_for_timeout(1500)  # the first frames, and the camera's first report
-        close = self.page.get_by_role("button", name="Close")
+        close = self.page.locator("button.mantine-Notification-closeButton")
         if close.count():  # viser's "software WebGL" notice swallows clicks under it
             close.first.click()
+
+    def picture(self, path) -> None:  # noqa: ANN001
+        """A screenshot for the README, without notices over the scene."""
+        for button in self.page.locator("button.mantine-Notification-closeButton").all():
+            if button.is_visible():
+                button.click()
+        self.page.wait_for_timeout(500)
+        self.page.screenshot(path=str(path))
 
     def screen(self, points: np.ndarray) -> np.ndarray:
         """(n, 2) page pixels of world points (n, 3), from the tab's own camera."""

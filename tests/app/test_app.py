@@ -85,6 +85,22 @@ def test_session_pairs_undo_redo(body, kimono):
         s.delete(7)
 
 
+def test_session_redraw_keeps_the_pair_number(body, kimono):
+    s = DressingSession(body, kimono, load_packaged_strokes("kimono_default"))
+    ids = [p.id for p in s.pairs]
+    s.delete(3, redraw=True)
+    assert 3 not in [p.id for p in s.pairs] and s.next_id() == 3
+    s.draw_pattern_stroke("migoro_right", np.array([[15.0, 100.0], [15.0, 150.0]]))
+    assert s.next_id() == 3  # still waiting for the body stroke
+    pair = s.draw_body_stroke(_front_of_body(body, 0.05, np.linspace(1.05, 1.3, 6)))
+    assert pair.id == 3 and [p.id for p in s.pairs] == ids  # back in its place, in order
+    assert s.next_id() == max(ids) + 1
+    s.undo()
+    s.undo()
+    s.undo()  # before the redraw: the old pair 3 is back
+    assert [p.id for p in s.pairs] == ids and s.next_id() == max(ids) + 1
+
+
 def test_session_loads_and_checks_strokes(body, kimono):
     s = DressingSession(body, kimono, load_packaged_strokes("kimono_default"))
     assert len(s.pairs) == 10 and all(p.body.resolved for p in s.pairs)
@@ -125,6 +141,12 @@ def test_draw_a_stroke_pair_with_the_mouse(app_page):
     app_page.page.get_by_role("button", name="Undo", exact=True).click()
     app_page.page.wait_for_timeout(500)
     assert len(s.pairs) == 0
+    app_page.page.get_by_role("button", name="Redo", exact=True).click()
+    app_page.page.wait_for_timeout(500)
+    assert [p.id for p in s.pairs] == [1] and view.pair_choice.value == "1"
+    app_page.page.get_by_role("button", name="Redraw pair").click()
+    app_page.page.wait_for_timeout(500)
+    assert s.pairs == [] and s.next_id() == 1
     assert all(u.startswith(("http://127.0.0.1", "ws://127.0.0.1", "data:", "blob:")) for u in app_page.requests)
 
 
@@ -158,7 +180,7 @@ def test_wrap_in_the_browser_then_save_the_garment(app_page, tmp_path):
     assert np.abs(after[patch].astype(int) - before[patch].astype(int)).mean() > 20
     # the README's picture of the app (KITSUKE_APP_SCREENSHOTS=docs pytest tests/app -k wrap rebuilds it)
     shots = Path(os.environ.get("KITSUKE_APP_SCREENSHOTS", tmp_path))
-    page.screenshot(path=str(shots / "app_kimono_dressed.png"))
+    app_page.picture(shots / "app_kimono_dressed.png")
     downloads = []
     page.on("download", lambda d: downloads.append(d))
     _drag_and_pin(app_page)
@@ -505,7 +527,7 @@ def test_a_skirt_from_nothing_in_the_browser(app_page):
     assert len(np.unique(np.floor(angle / 10))) == 36  # all the way round
 
 
-def test_edit_points_in_the_browser(app_page):
+def test_edit_points_in_the_browser(app_page, tmp_path):
     """Bend an edge by dragging its middle, add a point by clicking an edge, select and delete it, reverse a
     seam: each a browser gesture, each checked on the server's pattern."""
     view, page = app_page.view, app_page.page
@@ -525,6 +547,9 @@ def test_edit_points_in_the_browser(app_page):
     mid = bent.edge_points(top, np.array([0.5]))[0]
     assert abs(mid[1] - middles[top, 1] - 10.0) < 3.0  # the middle went up about 10 cm
     n = bent.n_edges
+    # the README's picture of the editor (KITSUKE_APP_SCREENSHOTS=docs pytest tests/app -k edit_points)
+    shots = Path(os.environ.get("KITSUKE_APP_SCREENSHOTS", tmp_path))
+    app_page.picture(shots / "app_pattern_editor.png")
     bottom = int(np.argmin(middles[:, 1]))
     board = view.board  # laid out afresh: the piece grew taller
     at = board.to_board(piece, bent.edge_points(bottom, np.array([0.3])))  # on the hem, a third of the way

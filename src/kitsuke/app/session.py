@@ -37,6 +37,7 @@ class _State:
     pairs: list[StrokePair] = field(default_factory=list)
     waiting: tuple[PatternStroke, ...] = ()  # the last pattern strokes drawn without a partner (at most 2)
     garment_pairs: list[StrokePair] = field(default_factory=list)  # re-wrap strokes, drawn on the garment
+    redraw: int | None = None  # the number the next pair drawn takes (a pair being redrawn)
 
 
 class DressingSession:
@@ -72,13 +73,24 @@ class DressingSession:
         return self._state.waiting
 
     def next_id(self) -> int:
+        """The number of the next pair drawn: the one being redrawn, or one past the highest."""
+        if self._state.redraw is not None:
+            return self._state.redraw
         return max((p.id for p in self._state.pairs), default=0) + 1
 
     def _change(
-        self, pairs: list[StrokePair], waiting: tuple[PatternStroke, ...], garment_pairs: list | None = None
+        self,
+        pairs: list[StrokePair],
+        waiting: tuple[PatternStroke, ...],
+        garment_pairs: list | None = None,
+        redraw: int | None = None,
     ) -> None:
+        """A new state (undoable); pairs kept in number order. A number being redrawn stays so until a pair
+        takes it (or `redraw` names another)."""
         kept = self._state.garment_pairs if garment_pairs is None else garment_pairs
-        self._history.push(_State(pairs, waiting, list(kept)))
+        if redraw is None and self._state.redraw not in {p.id for p in pairs}:
+            redraw = self._state.redraw
+        self._history.push(_State(sorted(pairs, key=lambda p: p.id), waiting, list(kept), redraw))
 
     def draw_pattern_stroke(self, piece: str, points_cm: np.ndarray) -> PatternStroke:
         """A stroke on a piece, in the pattern file's coordinates (cm); it waits for its body stroke (a body
@@ -120,7 +132,8 @@ class DressingSession:
             strokes.append(b)
         front, back = self._state.waiting
         n = self.next_id()
-        pairs = (StrokePair(n, front, strokes[0]), StrokePair(n + 1, back, strokes[1]))
+        after = max([n, *(p.id for p in self._state.pairs)]) + 1
+        pairs = (StrokePair(n, front, strokes[0]), StrokePair(after, back, strokes[1]))
         self._change([*self._state.pairs, *pairs], ())
         return pairs
 
@@ -152,14 +165,16 @@ class DressingSession:
         """A re-wrap or a new wrap: the re-wrap strokes were for the garment before it."""
         self._change(list(self._state.pairs), self._state.waiting, [])
 
-    def delete(self, pair_id: int) -> None:
+    def delete(self, pair_id: int, *, redraw: bool = False) -> None:
+        """Remove a pair; with `redraw`, the next pair drawn takes its number (and colour). InputError: no such
+        pair."""
         pairs = [p for p in self._state.pairs if p.id != pair_id]
         if len(pairs) == len(self._state.pairs):
             raise InputError(f"no stroke pair {pair_id}")
-        self._change(pairs, self._state.waiting)
+        self._change(pairs, self._state.waiting, redraw=pair_id if redraw else None)
 
     def clear(self) -> None:
-        self._change([], ())
+        self._history.push(_State([], (), list(self._state.garment_pairs)))
 
     def undo(self) -> bool:
         return self._history.undo()

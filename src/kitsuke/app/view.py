@@ -34,6 +34,7 @@ MAX_UPLOAD_BYTES = 50 * 2**20
 BODY_COLOR = (214, 190, 170)
 GARMENT_COLOR = (70, 95, 160)
 PIECE_COLOR = (246, 240, 228)
+SEAM_COLOR = (120, 120, 190)  # one colour for every seam: the stroke pairs own the bright ones
 BODY_SUFFIXES = (".obj", ".glb", ".gltf", ".ply")
 PATTERN_SUFFIXES = (".json", ".svg")
 #: A handle dragged less than this (board metres) stays where it was: a click that shook.
@@ -108,26 +109,33 @@ class ClientView:
         self._draw_handles()
 
     def _draw_seams(self) -> None:
-        """Each seam as two lines, numbered: from near a's start to the point of b it meets, and from near a's
-        end to its match. A twisted seam shows as two lines that cross."""
+        """Each seam: its two edges drawn thick and numbered alike, and one thin line from near
+        a's start to the point of b it meets there (the seam's direction: a twisted seam's line runs to the far
+        end of b)."""
         pattern = self.session.pattern
-        segments, colors = [], []
+        edges, links, labels = [], [], []
         for k, seam in enumerate(pattern.seams):
-            t = np.array([0.15, 0.85])
+            for ref in (seam.a, seam.b):
+                pts = self.board.to_board(ref.piece, pattern.piece(ref.piece).sample_edge(ref.edge))
+                edges += list(np.stack([pts[:-1], pts[1:]], axis=1))
+                mid = self.board.to_board(ref.piece, pattern.piece(ref.piece).edge_points(ref.edge, np.array([0.5])))
+                labels.append((f"{k}_{ref.piece}_{ref.edge}", str(k), mid[0] + [0, 0, 0.005]))
+            t = np.array([0.2])
             a = self.board.to_board(seam.a.piece, pattern.piece(seam.a.piece).edge_points(seam.a.edge, t))
-            b = self.board.to_board(
-                seam.b.piece, pattern.piece(seam.b.piece).edge_points(seam.b.edge, 1 - t if seam.reversed else t)
-            )
-            segments += [[a[0], b[0]], [a[1], b[1]]]
-            colors += [pair_color(k + 1)] * 2
-            mid = (a.mean(axis=0) + b.mean(axis=0)) / 2 + [0, 0, 0.005]
-            self.client.scene.add_label(f"/board/seam_labels/{k}", f"seam {k}", position=tuple(mid))
-        if segments:
-            pts = np.array(segments) + [0, 0, 0.004]
-            cols = np.repeat(np.array(colors, dtype=np.uint8)[:, None], 2, axis=1)
-            self.seam_handle = self.client.scene.add_line_segments(
-                "/board/seams", pts, cols, thickness=2.0, thickness_units="screen"
-            )
+            b = self.board.to_board(seam.b.piece, pattern.piece(seam.b.piece).edge_points(
+                seam.b.edge, 1 - t if seam.reversed else t))  # fmt: skip
+            links.append([a[0], b[0]])
+        if not edges:
+            return
+        self.seam_handle = self.client.scene.add_line_segments(
+            "/board/seams", np.array(edges) + [0, 0, 0.004], SEAM_COLOR, thickness=3.0, thickness_units="screen"
+        )
+        self.client.scene.add_line_segments(
+            "/board/seams/links", np.array(links) + [0, 0, 0.004], (120, 120, 140), thickness=1.0,
+            thickness_units="screen",
+        )  # fmt: skip
+        for name, text, at in labels:  # children of the seams' node: Show seams hides them too
+            self.client.scene.add_label(f"/board/seams/{name}", text, position=tuple(at))
 
     def _draw_problems(self) -> None:
         """The pattern's errors where they are: the edges at fault drawn red on their piece, with the message."""
@@ -166,7 +174,24 @@ class ClientView:
                     if kind == "point":
                         h.on_click()(self._point_clicked(name, i))
 
+    def _sync_pair_choice(self) -> str:
+        """The Pair list made to name the pairs there are; returns the chosen one ("(none)" without pairs)."""
+        names = [str(p.id) for p in self.session.pairs] or ["(none)"]
+        chosen = self.pair_choice.value if self.pair_choice.value in names else names[-1]
+        self._syncing = True  # setting the list's value calls its update, which must not redraw mid-redraw
+        try:
+            if tuple(self.pair_choice.options) != tuple(names):
+                self.pair_choice.options = names
+            if self.pair_choice.value != chosen:
+                self.pair_choice.value = chosen
+        finally:
+            self._syncing = False
+        return chosen
+
     def _redraw_strokes(self) -> None:
+        if getattr(self, "_syncing", False):
+            return
+        chosen = self._sync_pair_choice()
         scene = self.client.scene
         for handle in getattr(self, "_stroke_handles", []):
             handle.remove()
@@ -174,10 +199,11 @@ class ClientView:
         s = self.session
         for pair in s.pairs:
             color = pair_color(pair.id)
+            width = 8.0 if str(pair.id) == chosen else 4.0  # the chosen pair stands out
             on_board = self.board.to_board(pair.pattern.piece, s.pattern_points_on_piece(pair)) + [0, 0, 0.006]
             on_body = pair.body.surface_points + s.surface.normals_at(pair.body.faces) * 0.004
             for name, pts in ((f"/strokes/{pair.id}/pattern", on_board), (f"/strokes/{pair.id}/body", on_body)):
-                self._stroke_handles.append(self._polyline(name, pts, color))
+                self._stroke_handles.append(self._polyline(name, pts, color, width))
             self._stroke_handles.append(
                 scene.add_label(f"/strokes/{pair.id}/label", str(pair.id), position=tuple(on_body[0]))
             )
@@ -197,9 +223,9 @@ class ClientView:
     def _piece_points(self, stroke) -> np.ndarray:  # noqa: ANN001 - a PatternStroke in file coordinates
         return self.session.pattern.file_to_piece(stroke.piece, stroke.points)
 
-    def _polyline(self, name: str, pts: np.ndarray, color: tuple[int, int, int]):  # noqa: ANN202
+    def _polyline(self, name: str, pts: np.ndarray, color: tuple[int, int, int], width: float = 4.0):  # noqa: ANN202
         seg = np.stack([pts[:-1], pts[1:]], axis=1)
-        return self.client.scene.add_line_segments(name, seg, color, thickness=4.0, thickness_units="screen")
+        return self.client.scene.add_line_segments(name, seg, color, thickness=width, thickness_units="screen")
 
     # -- drawing ----------------------------------------------------------------------------------------------
     def _ray(self, event) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001
@@ -288,6 +314,12 @@ class ClientView:
             gui.add_button("Redo", icon="arrow-forward-up").on_click(lambda _: self._edit(self.session.redo))
             gui.add_button("Suggest strokes").on_click(lambda _: self._edit(self.session.suggest))
             gui.add_button("Clear strokes").on_click(lambda _: self._edit(self.session.clear))
+            self.pair_choice = gui.add_dropdown("Pair", ["(none)"])
+            self.pair_choice.on_update(lambda _: self._redraw_strokes())
+            gui.add_button("Delete pair").on_click(lambda _: self._pair_action(redraw=False))
+            gui.add_button(
+                "Redraw pair", hint="removes the pair: the next pattern and body strokes drawn take its number"
+            ).on_click(lambda _: self._pair_action(redraw=True))
             self.laser = gui.add_checkbox(
                 "Laser (front and back)", False,
                 hint="one stroke across the body lands on its front and its back, for the last two pattern strokes",
@@ -383,6 +415,7 @@ class ClientView:
 
     def _rebuild_scene(self) -> None:
         self.client.scene.reset()
+        self._stroke_handles = []  # gone with the scene
         self._build_scene()
         self._redraw_strokes()
 
@@ -524,6 +557,12 @@ class ClientView:
         if extra:
             lines.append(extra)
         self.status.content = "\n\n".join(lines)
+
+    def _pair_action(self, *, redraw: bool) -> None:
+        if not self.pair_choice.value.isdigit():
+            self.notify("No pair chosen", "Draw a stroke pair first, then choose it in the Pair list.", "yellow")
+            return
+        self._edit(lambda: self.session.delete(int(self.pair_choice.value), redraw=redraw))
 
     def _edit(self, action) -> None:  # noqa: ANN001
         try:
@@ -815,6 +854,7 @@ class ClientView:
             self.editor = PatternEditor(self.session.pattern)
         self.board = BoardLayout.of(self.session.pattern)
         self.client.scene.reset()
+        self._stroke_handles = []  # gone with the scene
         self._build_scene()
         names = self.session.pattern.piece_names
         if names and hasattr(self, "flip_choice"):
