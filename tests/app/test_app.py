@@ -85,6 +85,20 @@ def test_session_pairs_undo_redo(body, kimono):
         s.delete(7)
 
 
+def test_session_wraps_a_garmentcode_shirt_whose_file_mirrors_pieces(body):
+    """GarmentCode's files mirror some pieces; the session keeps strokes in the file's coordinates (for saving)
+    and gives wrap the pieces' own."""
+    from kitsuke.dressing import target_misses, wrap
+    from kitsuke.pattern import load_pattern
+
+    shirt = load_pattern(Path(__file__).parent.parent / "data" / "pattern" / "shirt_mean_specification.json")
+    assert shirt.file_mirrored
+    s = DressingSession(body, shirt)
+    assert s.suggest() == 8
+    g = wrap(body, shirt, s.wrap_strokes(), params=DressOptions().wrap_params(body, shirt))
+    assert target_misses(g) == []
+
+
 def test_session_redraw_keeps_the_pair_number(body, kimono):
     s = DressingSession(body, kimono, load_packaged_strokes("kimono_default"))
     ids = [p.id for p in s.pairs]
@@ -164,14 +178,9 @@ def test_wrap_in_the_browser_then_save_the_garment(app_page, tmp_path):
     page = app_page.page
     view = app_page.view
     before = np.asarray(Image.open(io.BytesIO(page.screenshot())))
-    page.get_by_role("button", name="Wrap", exact=True).click()
-    for _ in range(240):
-        if view.session.garment is not None and not view.busy:
-            break
-        page.wait_for_timeout(500)
-    g = view.session.garment
-    assert g is not None, "the wrap did not finish in 2 minutes"
-    assert getattr(view, "garment_handle", None) is not None
+    g = _wrap(app_page)
+    assert g is not None and view.outcome.startswith("Dressed")
+    assert view.garment_handle.visible
     page.wait_for_timeout(1500)
     after = np.asarray(Image.open(io.BytesIO(page.screenshot())))
     # where the body's trunk is on screen, the picture changed (the garment covers it)
@@ -217,6 +226,25 @@ def test_wrap_in_the_browser_then_save_the_garment(app_page, tmp_path):
     np.testing.assert_allclose(back.positions, now, atol=1e-5)  # the garment as dragged
 
 
+def _press_and_wait(app_page, button: str, timeout_s: float = 120.0) -> str:
+    """Press Wrap or Re-wrap and wait for its outcome (what the user is told); fails on a failed job."""
+    view, page = app_page.view, app_page.page
+    done = view.jobs_done
+    page.get_by_role("button", name=button, exact=True).click()
+    for _ in range(int(timeout_s / 0.5)):
+        page.wait_for_timeout(500)
+        if view.jobs_done > done:
+            assert "failed" not in view.outcome and "cancelled" not in view.outcome, view.outcome
+            return view.outcome
+    raise TimeoutError(f"{button} did not finish in {timeout_s:.0f} s")
+
+
+def _wrap(app_page):
+    """Press Wrap; the dressed garment."""
+    _press_and_wait(app_page, "Wrap")
+    return app_page.view.session.garment
+
+
 def _front_of(mesh_vertices: np.ndarray, faces: np.ndarray, x: float, y: float) -> np.ndarray:
     from kitsuke.geometry import TriMesh
 
@@ -248,12 +276,8 @@ def _rewrap(app_page) -> None:
     top = _front_of(d.positions, d.model.faces, -0.02, 1.0)
     app_page.drag(np.array([top + [0, dy, 0] for dy in (0.0, -0.05, -0.1)]))
     assert len(view.session.garment_pairs) == 1
-    page.get_by_role("button", name="Re-wrap", exact=True).click()
-    for _ in range(240):
-        page.wait_for_timeout(500)
-        if not view.busy and view.dragging is not d:
-            break
-    assert view.dragging is not d, "the re-wrap did not finish in 2 minutes"
+    _press_and_wait(app_page, "Re-wrap")
+    assert view.dragging is not d
     new = view.dragging.positions
     assert np.linalg.norm(new[: len(before)] - before, axis=1).max() > 0.01  # the cloth moved
     assert np.linalg.norm(new[pinned] - held, axis=1).max() < 3e-3  # the pin held
@@ -344,6 +368,27 @@ def test_open_a_garmentcode_shirt_and_suggest_strokes(app_page):
         page.wait_for_timeout(100)
     assert len(view.session.pairs) == 8
     page.get_by_text("8 stroke pair(s)").wait_for(timeout=15000)  # the panel says so
+    # one pair redrawn by hand (a front one: its body stroke faces the camera), then the shirt wrapped
+    front = next(p for p in view.session.pairs if (p.body.surface_points[:, 2] > 0.08).all())
+    pattern_pts = view.board.to_board(front.pattern.piece, view.session.pattern_points_on_piece(front))
+    body_pts = front.body.surface_points + [0, 0, 0.01]
+    view.pair_choice.value = str(front.id)
+    page.get_by_role("button", name="Redraw pair").click()
+    page.wait_for_timeout(500)
+    assert front.id not in [p.id for p in view.session.pairs]
+    app_page.drag(pattern_pts[:: max(1, len(pattern_pts) // 4)])
+    app_page.drag(body_pts[:: max(1, len(body_pts) // 4)])
+    redrawn = next(p for p in view.session.pairs if p.id == front.id)
+    assert redrawn.pattern.piece == front.pattern.piece
+    assert np.linalg.norm(redrawn.body.surface_points.mean(0) - front.body.surface_points.mean(0)) < 0.03
+    g = _wrap(app_page)
+    from kitsuke.dressing import target_misses
+    from kitsuke.metrics import penetration
+
+    lo, hi = g.positions.min(axis=0), g.positions.max(axis=0)
+    assert 0.9 < lo[1] < 1.2 and 1.35 < hi[1] < 1.6  # a shirt: from the hips to the shoulders
+    assert penetration(g.positions, view.session.body.mesh).deepest_mm < 5.0
+    assert all("strain" in m for m in target_misses(g)), target_misses(g)  # on the body; only strain may miss
 
 
 def test_session_garment_strokes_for_a_rewrap(body, kimono):
@@ -427,7 +472,7 @@ def test_editor_builds_a_skirt_that_hangs_round_the_waist(body):
         xs_ = np.linspace(*xs, 5)
         o = np.c_[xs_, np.full(5, 0.95), np.full(5, 2.0 * z)]
         s.draw_body_stroke(surface.cast(o, np.tile([0, 0, -z], (5, 1))).points)
-    g = wrap(body, p, s.strokes(), params=DressOptions().wrap_params(body, p))
+    g = wrap(body, p, s.wrap_strokes(), params=DressOptions().wrap_params(body, p))
     lo, hi = g.positions.min(axis=0), g.positions.max(axis=0)
     assert 0.85 < hi[1] < 1.1 and lo[1] > 0.3  # from the waist down, not to the floor
     angle = np.degrees(np.arctan2(g.positions[:, 2] - 0.03, g.positions[:, 0]))
@@ -514,13 +559,7 @@ def test_a_skirt_from_nothing_in_the_browser(app_page):
     across = _front_of_body(view.session.body, 0.0, np.array([0.95]))[0]
     app_page.drag(np.array([across + [dx, 0, 0] for dx in (-0.1, -0.03, 0.03, 0.1)]))
     assert len(view.session.pairs) == 2
-    page.get_by_role("button", name="Wrap", exact=True).click()
-    for _ in range(240):
-        if view.session.garment is not None and not view.busy:
-            break
-        page.wait_for_timeout(500)
-    g = view.session.garment
-    assert g is not None, "the wrap did not finish in 2 minutes"
+    g = _wrap(app_page)
     lo, hi = g.positions.min(axis=0), g.positions.max(axis=0)
     assert 0.85 < hi[1] < 1.15 and lo[1] > 0.3  # from the waist down, not to the floor
     angle = np.degrees(np.arctan2(g.positions[:, 2] - 0.03, g.positions[:, 0]))

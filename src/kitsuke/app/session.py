@@ -187,6 +187,11 @@ class DressingSession:
         """The pairs drawn, as Strokes (pattern points in the file's coordinates)."""
         return Strokes(list(self._state.pairs), "body", {"drawn_in": "kitsuke app"})
 
+    def wrap_strokes(self) -> Strokes:
+        """The pairs as `kitsuke.dressing.wrap` takes strokes already on the body: pattern points in the pieces'
+        own coordinates (a GarmentCode file mirrors some pieces; `strokes()` keeps the file's)."""
+        return in_piece_frame(self.strokes(), self.pattern)
+
     def load_strokes(self, strokes: Strokes) -> None:
         """Replace the pairs by those of a strokes file (checked against the pattern; body strokes put on the
         body)."""

@@ -64,6 +64,8 @@ class ClientView:
         self.drawing: _Drawing | None = None
         self.cancel = threading.Event()
         self.busy = False
+        self.outcome = ""
+        self.jobs_done = 0
         self._build_panel()
         self._build_scene()
         self._redraw_strokes()
@@ -579,7 +581,7 @@ class ClientView:
         from dataclasses import replace
 
         s = self.session
-        strokes = s.strokes()
+        strokes = s.wrap_strokes()
         if not len(strokes):
             self.notify("No strokes yet", "Draw at least one stroke pair (pattern, then body) to wrap.", "yellow")
             return
@@ -785,6 +787,8 @@ class ClientView:
         ticking.set()
         note.remove()
         self.notify(title, body, color)
+        self.outcome = f"{title}: {body}"  # the last wrap's or re-wrap's, as said to the user
+        self.jobs_done += 1
         self.busy = False
         self.wrap_button.disabled = False
         self.cancel_button.disabled = True
