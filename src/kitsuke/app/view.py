@@ -587,7 +587,8 @@ class ClientView:
             return
         params = replace(self.app.options, edge_length=float(self.edge.value)).wrap_params(s.body, s.pattern)
         self._start_job(
-            "Wrapping", lambda: self.app.worker.wrap(s.body, s.pattern, strokes, params, cancel=self.cancel),
+            "Wrapping",
+            lambda say: self.app.worker.wrap(s.body, s.pattern, strokes, params, cancel=self.cancel, progress=say),
             self._wrapped,
         )  # fmt: skip
 
@@ -599,13 +600,13 @@ class ClientView:
             return
         garment, strokes, pins = d.garment(), s.garment_strokes(), d.positions[d.pinned].copy()
         self._start_job(
-            "Re-wrapping", lambda: self.app.worker.rewrap(s.body, garment, strokes, pins, cancel=self.cancel),
+            "Re-wrapping", lambda _say: self.app.worker.rewrap(s.body, garment, strokes, pins, cancel=self.cancel),
             self._rewrapped,
         )  # fmt: skip
 
     def _start_job(self, title: str, compute, done) -> None:  # noqa: ANN001
-        """Run `compute` (a wrap or re-wrap in the worker) in a thread, with its elapsed time shown and Cancel
-        armed; `done(result)` takes what it gives."""
+        """Run `compute(progress)` (a wrap or re-wrap in the worker; `progress(stage)` names the stage it is in) in
+        a thread, with its stage and elapsed time shown and Cancel armed; `done(result)` takes what it gives."""
         if self.busy:
             return
         self.busy = True
@@ -618,14 +619,17 @@ class ClientView:
         note = self.client.add_notification(title, "0 s", loading=True, with_close_button=False)
         ticking = threading.Event()
 
-        def tick() -> None:  # the elapsed time, so that a long wrap is seen to be working
+        stage = [""]  # the wrap's stage now, as its child process says
+
+        def tick() -> None:  # the stage and the elapsed time, so that a long wrap is seen to be working
             t0 = time.monotonic()
             while not ticking.wait(0.5):
-                note.body = f"{time.monotonic() - t0:.0f} s (Cancel wrap stops it)"
+                now = f"{stage[0]}, " if stage[0] else ""
+                note.body = f"{now}{time.monotonic() - t0:.0f} s (Cancel wrap stops it)"
 
         threading.Thread(target=tick, daemon=True).start()
         try:
-            result = compute()
+            result = compute(lambda name: stage.__setitem__(0, name))
         except Cancelled:
             self._job_ended(note, ticking, f"{title} cancelled", "Nothing changed.", "yellow")
             return

@@ -11,6 +11,7 @@ from __future__ import annotations
 import multiprocessing as mp
 import threading
 import time
+from collections.abc import Callable
 
 from ..errors import ComputationError, InputError
 
@@ -21,7 +22,7 @@ class Cancelled(Exception):
 
 def _serve(conn) -> None:  # noqa: ANN001 - a multiprocessing Connection
     """The child: take ("wrap", body, pattern, strokes, params) or ("rewrap", body, garment, strokes, pins) jobs,
-    answer ("ok", result) or the error."""
+    say ("stage", name) as a wrap goes, and answer ("ok", result) or the error."""
     import signal
 
     from ..dressing import wrap
@@ -37,7 +38,7 @@ def _serve(conn) -> None:  # noqa: ANN001 - a multiprocessing Connection
         kind, body, garment, strokes, extra = job
         try:
             if kind == "wrap":
-                result = wrap(body, garment, strokes, params=extra)
+                result = wrap(body, garment, strokes, params=extra, progress=lambda s: conn.send(("stage", s)))
             else:
                 result = rewrap(body, garment, strokes, pins=extra).garment
             conn.send(("ok", result))
@@ -70,35 +71,51 @@ class WrapWorker:
             self._proc.join(timeout=5)
         self._start()
 
-    def wrap(self, body, pattern, strokes, params, *, cancel: threading.Event | None = None, timeout_s: float = 600):  # noqa: ANN001, ANN201
-        """The garment of `kitsuke.dressing.wrap(body, pattern, strokes, params=params)`, computed in the child.
+    def wrap(
+        self,
+        body,
+        pattern,
+        strokes,
+        params,
+        *,
+        cancel: threading.Event | None = None,
+        timeout_s: float = 600,
+        progress: Callable[[str], None] | None = None,
+    ):  # noqa: ANN001, ANN201
+        """The garment of `kitsuke.dressing.wrap(body, pattern, strokes, params=params)`, computed in the child;
+        `progress(stage)` hears each stage as it starts.
 
         Raises what wrap raises (InputError, ComputationError), Cancelled when `cancel` is set, and
         ComputationError ("wrap") when the child dies or the wrap takes longer than `timeout_s`."""
-        return self._run(("wrap", body, pattern, strokes, params), cancel, timeout_s)
+        return self._run(("wrap", body, pattern, strokes, params), cancel, timeout_s, progress)
 
     def rewrap(self, body, garment, strokes, pins, *, cancel: threading.Event | None = None, timeout_s: float = 600):  # noqa: ANN001, ANN201
         """The garment (a GarmentFile) of `kitsuke.dressing.rewrap.rewrap(body, garment, strokes, pins=pins)`,
         computed in the child; raises as `wrap` does."""
         return self._run(("rewrap", body, garment, strokes, pins), cancel, timeout_s)
 
-    def _run(self, job: tuple, cancel: threading.Event | None, timeout_s: float):  # noqa: ANN202
+    def _run(self, job: tuple, cancel: threading.Event | None, timeout_s: float, progress=None):  # noqa: ANN001, ANN202
         with self._lock:
             if self._proc is None or not self._proc.is_alive():
                 self._start()
             self._conn.send(job)
             t0 = time.monotonic()
-            while not self._conn.poll(0.1):
-                if cancel is not None and cancel.is_set():
-                    self._restart()
-                    raise Cancelled()
-                if not self._proc.is_alive():
-                    self._start()
-                    raise ComputationError("wrap", "the wrap's process died (out of memory?)")
-                if time.monotonic() - t0 > timeout_s:
-                    self._restart()
-                    raise ComputationError("wrap", f"the wrap took longer than {timeout_s:.0f} s and was stopped")
-            answer = self._conn.recv()
+            while True:
+                while not self._conn.poll(0.1):
+                    if cancel is not None and cancel.is_set():
+                        self._restart()
+                        raise Cancelled()
+                    if not self._proc.is_alive():
+                        self._start()
+                        raise ComputationError("wrap", "the wrap's process died (out of memory?)")
+                    if time.monotonic() - t0 > timeout_s:
+                        self._restart()
+                        raise ComputationError("wrap", f"the wrap took longer than {timeout_s:.0f} s and was stopped")
+                answer = self._conn.recv()
+                if answer[0] != "stage":
+                    break
+                if progress is not None:
+                    progress(answer[1])
         kind = answer[0]
         if kind == "ok":
             return answer[1]
