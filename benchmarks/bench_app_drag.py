@@ -30,6 +30,10 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 
 
+def _bytes(frame) -> bytes:  # noqa: ANN001 - a websocket frame's payload (bytes or str)
+    return frame if isinstance(frame, bytes) else frame.encode()
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--edge-cm", type=float, default=2.5)
@@ -51,6 +55,16 @@ def main() -> None:
     with sync_playwright() as pw:
         browser = pw.chromium.launch(executable_path=shutil.which("chromium"), args=FLAGS)
         page = browser.new_page(viewport=VIEWPORT)
+        # the round trip, seen from the page: each drag message it sends, and each garment update it receives
+        # (the largest frames: the vertices); an update answers the last drag message sent before it
+        sent: list[float] = []
+        received: list[float] = []
+
+        def on_ws(ws) -> None:  # noqa: ANN001
+            ws.on("framesent", lambda f: sent.append(time.perf_counter()) if b"Drag" in _bytes(f) else None)
+            ws.on("framereceived", lambda f: received.append(time.perf_counter()) if len(_bytes(f)) > 40_000 else None)
+
+        page.on("websocket", on_ws)
         ap_ = AppPage(app, page)
         page.goto(app.url)
         ap_.wait_connected()
@@ -83,6 +97,8 @@ def main() -> None:
             page.wait_for_timeout(16)
         drag_s = time.perf_counter() - t0
         m.up()
+        in_drag = [r for r in received if t0 <= r <= t0 + drag_s]
+        trips = [r - max(x for x in sent if x < r) for r in in_drag if any(x < r for x in sent)]
         t_up = time.perf_counter()
         while view.dragger.busy or view.dragger._ops:
             time.sleep(0.05)
@@ -118,6 +134,8 @@ def main() -> None:
             "update_ms_median": round(float(np.median(upd)) * 1e3, 1),
             "update_ms_p95": round(float(np.percentile(upd, 95)) * 1e3, 1),
             "release_s": round(release_s, 2),
+            "browser_updates_received_per_s": round(len(in_drag) / drag_s, 1),
+            "browser_round_trip_ms_median": round(1e3 * float(np.median(trips)), 0) if trips else None,
             "server_alone_updates_per_s": round(len(server_upd) / server_s, 1),
             "server_alone_update_ms_median": round(float(np.median(server_upd)) * 1e3, 1),
             "machine": {"cores": os.cpu_count(), "processor": platform.processor(), "load": os.getloadavg()},

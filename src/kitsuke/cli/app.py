@@ -9,9 +9,12 @@ from ._common import add_body_options
 EPILOG = """\
 Opens a local web page with the body and the pattern's pieces side by side. Press and drag on a pattern piece to
 draw a stroke, then press and drag on the body to draw where it goes: each pair gets a number and a colour. Drag
-on empty space to turn the view. Wrap puts the garment on the body (a few seconds to a minute; Cancel wrap stops
-it); Save writes the garment (GLB, OBJ with pattern UVs, report) and the strokes through the browser's downloads.
-Open another body, pattern or strokes file from the panel (at most 50 MB; never a path on this machine).
+on empty space to turn the view. Wrap puts the garment on the body (a few seconds to a minute, its stage shown;
+Cancel wrap stops it). Then drag the garment along the body, pin it with clicks, draw on it and re-wrap, or tick
+Show strain. Edit the pattern in the panel: draw pieces by their corners, move, add and delete points, bend edges,
+sew, turn pieces over. Save writes the garment (GLB, OBJ with pattern UVs, report), the strokes, the drags and the
+pattern through the browser's downloads. Open another body, pattern or strokes file from the panel (at most 50 MB;
+never a path on this machine).
 
 It listens on 127.0.0.1 only unless --host says otherwise (0.0.0.0: every network this machine is on; anyone who
 can reach the port can use the app). Each browser tab is its own session; the tabs' wraps run one at a time.
@@ -24,7 +27,7 @@ examples:
 
 
 def register(parser: argparse.ArgumentParser) -> None:
-    parser.description = "The browser app: draw strokes on the pattern and the body, wrap, save."
+    parser.description = "The browser app: draw strokes, edit the pattern, wrap, drag, pin, save."
     parser.epilog = EPILOG
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.add_argument("--body", default="default", metavar="BODY", help="body mesh file or `default`")
