@@ -134,6 +134,7 @@ def main() -> None:
             "update_ms_median": round(float(np.median(upd)) * 1e3, 1),
             "update_ms_p95": round(float(np.percentile(upd, 95)) * 1e3, 1),
             "release_s": round(release_s, 2),
+            "browser_drag_messages_sent_per_s": round(sum(t0 <= x <= t0 + drag_s for x in sent) / drag_s, 1),
             "browser_updates_received_per_s": round(len(in_drag) / drag_s, 1),
             "browser_round_trip_ms_median": round(1e3 * float(np.median(trips)), 0) if trips else None,
             "server_alone_updates_per_s": round(len(server_upd) / server_s, 1),
