@@ -523,7 +523,7 @@ def test_a_skirt_from_nothing_in_the_browser(app_page):
         px = app_page.screen(np.array([[x, y, z]]))[0]
         page.mouse.click(float(px[0]), float(px[1]))
         page.wait_for_timeout(250)
-    assert len(view.corners) == 4
+    assert len(view.tools.corners) == 4
     page.get_by_role("button", name="Close the piece").click()
     page.wait_for_timeout(800)
     assert view.session.pattern.piece_names == ["piece1"]
@@ -603,7 +603,7 @@ def test_edit_points_in_the_browser(app_page, tmp_path):
     px = app_page.screen(board.to_board(piece, points[new_point : new_point + 1]) + [0, 0, 0.01])
     page.mouse.click(float(px[0, 0]), float(px[0, 1]))
     page.wait_for_timeout(800)
-    assert view.selected_point == (piece, new_point)
+    assert view.tools.selected_point == (piece, new_point)
     page.get_by_role("button", name="Delete point").click()
     page.wait_for_timeout(800)
     assert view.session.pattern.piece(piece).n_edges == n

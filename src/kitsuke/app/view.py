@@ -23,6 +23,7 @@ from .board import BoardLayout
 from .drag_history import DragHistory
 from .dragger import Dragger
 from .editor import PatternEditor
+from .editor_view import EditorTools
 from .session import DressingSession, pair_color
 from .worker import Cancelled
 
@@ -34,11 +35,8 @@ MAX_UPLOAD_BYTES = 50 * 2**20
 BODY_COLOR = (214, 190, 170)
 GARMENT_COLOR = (70, 95, 160)
 PIECE_COLOR = (246, 240, 228)
-SEAM_COLOR = (120, 120, 190)  # one colour for every seam: the stroke pairs own the bright ones
 BODY_SUFFIXES = (".obj", ".glb", ".gltf", ".ply")
 PATTERN_SUFFIXES = (".json", ".svg")
-#: A handle dragged less than this (board metres) stays where it was: a click that shook.
-CLICK_SLOP_M = 0.004
 
 
 @dataclass
@@ -56,11 +54,8 @@ class ClientView:
         self.app = app
         self.client = client
         self.session = DressingSession(app.body, app.pattern, app.strokes)
-        self.editor = PatternEditor(app.pattern)
+        self.tools = EditorTools(self, PatternEditor(app.pattern))
         self.board = BoardLayout.of(app.pattern)
-        self.corners: list[np.ndarray] = []  # a piece being drawn, corner by corner (board metres)
-        self.sewing: list = []  # the first edge picked for a seam
-        self.selected_point: tuple[str, int] | None = None  # (piece, point index) in point mode
         self.drawing: _Drawing | None = None
         self.cancel = threading.Event()
         self.busy = False
@@ -69,7 +64,12 @@ class ClientView:
         self._build_panel()
         self._build_scene()
         self._redraw_strokes()
-        client.scene.on_click()(self._on_scene_click)  # corners of a piece being drawn (once: scenes are rebuilt)
+        client.scene.on_click()(self.tools.scene_clicked)  # corners of a piece being drawn (once: scenes are rebuilt)
+
+    @property
+    def editor(self) -> PatternEditor:
+        """The pattern being edited, with its undo history."""
+        return self.tools.editor
 
     # -- scene ------------------------------------------------------------------------------------------------
     def _build_scene(self) -> None:
@@ -94,7 +94,7 @@ class ClientView:
                 f"/board/{name}", verts.astype(np.float32), faces.astype(np.uint32), color=PIECE_COLOR, side="double"
             )
             h.on_drag()(self._piece_drag_handler(name))
-            h.on_click()(self._piece_click_handler(name))
+            h.on_click()(self.tools.piece_click_handler(name))
             self.piece_handles[name] = h
             piece = self.session.pattern.piece(name)
             outline = np.concatenate([piece.sample_edge(e)[:-1] for e in range(piece.n_edges)])
@@ -106,75 +106,13 @@ class ClientView:
             low, high = piece.bounds
             top = self.board.to_board(name, np.array([[(low[0] + high[0]) / 2, high[1]]]))[0]
             scene.add_label(f"/board/{name}/name", name, position=tuple(top + [0, 0.03, 0]), anchor="bottom-center")
-        self._draw_seams()
-        self._draw_problems()
-        self._draw_handles()
+        self.tools.draw()
 
-    def _draw_seams(self) -> None:
-        """Each seam: its two edges drawn thick and numbered alike, and one thin line from near
-        a's start to the point of b it meets there (the seam's direction: a twisted seam's line runs to the far
-        end of b)."""
-        pattern = self.session.pattern
-        edges, links, labels = [], [], []
-        for k, seam in enumerate(pattern.seams):
-            for ref in (seam.a, seam.b):
-                pts = self.board.to_board(ref.piece, pattern.piece(ref.piece).sample_edge(ref.edge))
-                edges += list(np.stack([pts[:-1], pts[1:]], axis=1))
-                mid = self.board.to_board(ref.piece, pattern.piece(ref.piece).edge_points(ref.edge, np.array([0.5])))
-                labels.append((f"{k}_{ref.piece}_{ref.edge}", str(k), mid[0] + [0, 0, 0.005]))
-            t = np.array([0.2])
-            a = self.board.to_board(seam.a.piece, pattern.piece(seam.a.piece).edge_points(seam.a.edge, t))
-            b = self.board.to_board(seam.b.piece, pattern.piece(seam.b.piece).edge_points(
-                seam.b.edge, 1 - t if seam.reversed else t))  # fmt: skip
-            links.append([a[0], b[0]])
-        if not edges:
-            return
-        self.seam_handle = self.client.scene.add_line_segments(
-            "/board/seams", np.array(edges) + [0, 0, 0.004], SEAM_COLOR, thickness=3.0, thickness_units="screen"
-        )
-        self.client.scene.add_line_segments(
-            "/board/seams/links", np.array(links) + [0, 0, 0.004], (120, 120, 140), thickness=1.0,
-            thickness_units="screen",
-        )  # fmt: skip
-        for name, text, at in labels:  # children of the seams' node: Show seams hides them too
-            self.client.scene.add_label(f"/board/seams/{name}", text, position=tuple(at))
-
-    def _draw_problems(self) -> None:
-        """The pattern's errors where they are: the edges at fault drawn red on their piece, with the message."""
-        for k, issue in enumerate(i for i in self.editor.issues() if i.severity == "error" and i.piece):
-            if issue.piece not in self.board.places:
-                continue
-            piece = self.session.pattern.piece(issue.piece)
-            edges = issue.edges or tuple(range(piece.n_edges))
-            for e in edges:
-                pts = self.board.to_board(issue.piece, piece.sample_edge(e)) + [0, 0, 0.005]
-                self.client.scene.add_line_segments(
-                    f"/board/problems/{k}/{e}", np.stack([pts[:-1], pts[1:]], axis=1), (220, 30, 30),
-                    thickness=5.0, thickness_units="screen",
-                )  # fmt: skip
-            low, high = piece.bounds
-            at = self.board.to_board(issue.piece, np.array([(low + high) / 2]))[0] + [0, 0, 0.01]
-            self.client.scene.add_label(f"/board/problems/{k}/label", issue.message, position=tuple(at))
-
-    def _draw_handles(self) -> None:
-        """In point mode: each piece's points (drag to move, click to select) and its edges' middles (drag to
-        bend the edge)."""
-        if not self.point_mode.value:
-            return
-        r = 0.012  # metres on the board: 2.4 cm of pattern
-        for name in self.session.pattern.piece_names:
-            points, middles = self.editor.handles(name)
-            for kind, pts, color in (("point", points, (150, 30, 30)), ("middle", middles, (30, 90, 200))):
-                on_board = self.board.to_board(name, pts) + [0, 0, 0.01]
-                for i, at in enumerate(on_board):
-                    selected = kind == "point" and self.selected_point == (name, i)
-                    h = self.client.scene.add_icosphere(
-                        f"/board/handles/{name}/{kind}{i}", r * (1.5 if selected else 1.0),
-                        (250, 180, 0) if selected else color, position=tuple(at), subdivisions=1,
-                    )  # fmt: skip
-                    h.on_drag()(self._handle_drag(name, kind, i))
-                    if kind == "point":
-                        h.on_click()(self._point_clicked(name, i))
+    def rebuild_scene(self) -> None:
+        self.client.scene.reset()
+        self._stroke_handles = []  # gone with the scene
+        self._build_scene()
+        self._redraw_strokes()
 
     def _sync_pair_choice(self) -> str:
         """The Pair list made to name the pairs there are; returns the chosen one ("(none)" without pairs)."""
@@ -205,32 +143,32 @@ class ClientView:
             on_board = self.board.to_board(pair.pattern.piece, s.pattern_points_on_piece(pair)) + [0, 0, 0.006]
             on_body = pair.body.surface_points + s.surface.normals_at(pair.body.faces) * 0.004
             for name, pts in ((f"/strokes/{pair.id}/pattern", on_board), (f"/strokes/{pair.id}/body", on_body)):
-                self._stroke_handles.append(self._polyline(name, pts, color, width))
+                self._stroke_handles.append(self.polyline(name, pts, color, width))
             self._stroke_handles.append(
                 scene.add_label(f"/strokes/{pair.id}/label", str(pair.id), position=tuple(on_body[0]))
             )
         for pair in s.garment_pairs:
             color = pair_color(pair.id)
             on_board = self.board.to_board(pair.pattern.piece, pair.pattern.points) + [0, 0, 0.006]
-            self._stroke_handles.append(self._polyline(f"/rewrap/{pair.id}/pattern", on_board, color))
+            self._stroke_handles.append(self.polyline(f"/rewrap/{pair.id}/pattern", on_board, color))
             self._stroke_handles.append(
-                self._polyline(f"/rewrap/{pair.id}/garment", pair.body.surface_points + [0, 0, 0.004], color)
+                self.polyline(f"/rewrap/{pair.id}/garment", pair.body.surface_points + [0, 0, 0.004], color)
             )
         shown = s.waiting if self.laser.value else s.waiting[-1:]
         for k, stroke in enumerate(shown):
             pts = self.board.to_board(stroke.piece, self._piece_points(stroke)) + [0, 0, 0.006]
-            self._stroke_handles.append(self._polyline(f"/strokes/pending{k}", pts, (40, 40, 40)))
-        self._status()
+            self._stroke_handles.append(self.polyline(f"/strokes/pending{k}", pts, (40, 40, 40)))
+        self.status_line()
 
     def _piece_points(self, stroke) -> np.ndarray:  # noqa: ANN001 - a PatternStroke in file coordinates
         return self.session.pattern.file_to_piece(stroke.piece, stroke.points)
 
-    def _polyline(self, name: str, pts: np.ndarray, color: tuple[int, int, int], width: float = 4.0):  # noqa: ANN202
+    def polyline(self, name: str, pts: np.ndarray, color: tuple[int, int, int], width: float = 4.0):  # noqa: ANN202
         seg = np.stack([pts[:-1], pts[1:]], axis=1)
         return self.client.scene.add_line_segments(name, seg, color, thickness=width, thickness_units="screen")
 
     # -- drawing ----------------------------------------------------------------------------------------------
-    def _ray(self, event) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001
+    def ray(self, event) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001
         """The pointer's ray at a drag event: from the camera through the reported point."""
         eye = np.asarray(event.client.camera.position, dtype=np.float64)
         through = np.asarray(event.end_position, dtype=np.float64)
@@ -243,7 +181,7 @@ class ClientView:
                 return
             if self.drawing is None or self.drawing.piece != piece:
                 return
-            hit = self.board.on_board(*self._ray(event))
+            hit = self.board.on_board(*self.ray(event))
             if hit is not None:
                 self.drawing.points.append(hit)
             if event.phase == "end":
@@ -260,7 +198,7 @@ class ClientView:
             return
         if self.drawing is None or self.drawing.piece is not None:
             return
-        eye, direction = self._ray(event)
+        eye, direction = self.ray(event)
         hit = self.session.surface.cast(eye[None], direction[None], hit="first")
         if hit.hit.all():
             self.drawing.points.append(hit.points[0])
@@ -276,7 +214,7 @@ class ClientView:
             return
         if self.drawing is None or self.drawing.piece is not None:
             return
-        self.drawing.points.append(np.r_[self._ray(event)])
+        self.drawing.points.append(np.r_[self.ray(event)])
         if event.phase == "end":
             rays, self.drawing = np.array(self.drawing.points), None
             if len(rays) >= 2:
@@ -329,38 +267,14 @@ class ClientView:
             self.laser.on_update(lambda _: self._redraw_strokes())
         with gui.add_folder("View"):
             seams = gui.add_checkbox("Show seams", True)
-            seams.on_update(lambda _: self._show_seams(seams.value))
+            seams.on_update(lambda _: self.tools.show_seams(seams.value))
             pieces = self.session.pattern.piece_names
             self.flip_choice = gui.add_dropdown("Piece", pieces, initial_value=pieces[0])
-            gui.add_button("Turn piece over").on_click(lambda _: self._flip(self.flip_choice.value))
+            gui.add_button("Turn piece over").on_click(
+                lambda _: self.tools.apply(lambda: self.editor.flip(self.flip_choice.value))
+            )
         with gui.add_folder("Edit the pattern", expand_by_default=False):
-            gui.add_button("New empty pattern").on_click(lambda _: self._new_pattern())
-            self.piece_mode = gui.add_checkbox("Draw a piece: click its corners", False)
-            gui.add_button("Close the piece").on_click(lambda _: self._close_piece())
-            self.sew_mode = gui.add_checkbox("Sew: click two edges", False)
-            self.point_mode = gui.add_checkbox(
-                "Edit points", False,
-                hint="drag a red point to move it, a blue one to bend its edge; click an edge to add a point there, "
-                "click a point to select it for Delete point",
-            )  # fmt: skip
-            self.point_mode.on_update(lambda _: self._rebuild_scene())
-            gui.add_button("Delete point").on_click(lambda _: self._delete_point())
-            self.seam_choice = gui.add_dropdown("Seam", self._seam_names())
-            gui.add_button("Reverse seam").on_click(lambda _: self._seam_action(self.editor.reverse_seam))
-            gui.add_button("Unsew").on_click(lambda _: self._seam_action(self.editor.unsew))
-            gui.add_button("Duplicate piece").on_click(
-                lambda _: self._edit_pattern(lambda: self.editor.duplicate(self.flip_choice.value))
-            )
-            gui.add_button("Mirror piece").on_click(
-                lambda _: self._edit_pattern(lambda: self.editor.mirror(self.flip_choice.value))
-            )
-            gui.add_button("Delete piece").on_click(
-                lambda _: self._edit_pattern(lambda: self.editor.delete_piece(self.flip_choice.value))
-            )
-            gui.add_button("Undo edit").on_click(lambda _: self._edit_pattern(self.editor.undo))
-            gui.add_button("Redo edit").on_click(lambda _: self._edit_pattern(self.editor.redo))
-            gui.add_button("Save pattern (JSON)").on_click(lambda _: self._download_pattern())
-            self.issues_md = gui.add_markdown("")
+            self.tools.build_panel(gui)
         with gui.add_folder("Wrap"):
             self.edge = gui.add_number(
                 "Mesh edge (cm)", self.app.options.edge_length, min=0.5, max=5.0, step=0.5,
@@ -400,148 +314,7 @@ class ClientView:
             self.drag_history.unpin_all()
             self._show_pins()
 
-    def _show_seams(self, on: bool) -> None:
-        if getattr(self, "seam_handle", None) is not None:
-            self.seam_handle.visible = on
-
-    # -- the pattern editor -----------------------------------------------------------------------------------
-    def _edit_pattern(self, action) -> None:  # noqa: ANN001 - an editor call
-        try:
-            warning = action()
-        except InputError as e:
-            self.notify("Not done", e.message, "red")
-            return
-        if isinstance(warning, str):  # a length mismatch, or a seam an edit removed
-            self.notify("Done, but", warning, "yellow")
-        self._replace(pattern=self.editor.pattern, keep_editor=True)
-
-    def _rebuild_scene(self) -> None:
-        self.client.scene.reset()
-        self._stroke_handles = []  # gone with the scene
-        self._build_scene()
-        self._redraw_strokes()
-
-    def _seam_names(self) -> list[str]:
-        names = [f"{k}: {s.a} to {s.b}" for k, s in enumerate(self.session.pattern.seams)]
-        return names or ["(no seams)"]
-
-    def _seam_action(self, action) -> None:  # noqa: ANN001 - an editor call on one edge of the seam
-        seams = self.editor.pattern.seams
-        k = int(self.seam_choice.value.split(":")[0]) if self.seam_choice.value[0].isdigit() else -1
-        if not 0 <= k < len(seams):
-            self.notify("No seam chosen", "Sew two edges first (Sew: click two edges).", "yellow")
-            return
-        self._edit_pattern(lambda: action(seams[k].a))
-
-    def _handle_drag(self, piece: str, kind: str, index: int):  # noqa: ANN202
-        """A point handle moves the point; an edge's middle handle bends the edge (applied on release)."""
-        pressed: list[np.ndarray] = []
-
-        async def handler(event) -> None:  # noqa: ANN001
-            hit = self.board.on_board(*self._ray(event))
-            if hit is None:
-                return
-            if event.phase == "start":
-                pressed[:] = [hit]
-                return
-            event.target.position = tuple(hit + [0, 0, 0.01])  # follows the pointer while dragged
-            if event.phase != "end":
-                return
-            if pressed and np.linalg.norm(hit - pressed[0]) < CLICK_SLOP_M:  # a shaky click: nothing moves
-                self._rebuild_scene()
-                return
-            cm = self.board.to_piece(piece, hit[None])[0]
-            if kind == "point":
-                self._edit_pattern(lambda: self.editor.move_point(piece, index, cm))
-            else:
-                self._edit_pattern(lambda: self.editor.curve_edge(piece, index, cm))
-
-        return handler
-
-    def _point_clicked(self, piece: str, index: int):  # noqa: ANN202
-        def handler(_event) -> None:  # noqa: ANN001
-            self.selected_point = None if self.selected_point == (piece, index) else (piece, index)
-            self._rebuild_scene()
-
-        return handler
-
-    def _delete_point(self) -> None:
-        if self.selected_point is None:
-            self.notify("No point selected", "Tick Edit points and click a red point first.", "yellow")
-            return
-        (piece, index), self.selected_point = self.selected_point, None
-        self._edit_pattern(lambda: self.editor.delete_point(piece, index))
-
-    def _on_scene_click(self, event) -> None:  # noqa: ANN001
-        """A corner of the piece being drawn, where the click's ray meets the board."""
-        if not self.piece_mode.value or event.ray_origin is None:
-            return
-        hit = self.board.on_board(np.asarray(event.ray_origin), np.asarray(event.ray_direction))
-        if hit is None:
-            return
-        self.corners.append(hit)
-        self._show_corners()
-
-    def _show_corners(self) -> None:
-        scene = self.client.scene
-        if not self.corners:
-            scene.remove_by_name("/new_piece")
-            return
-        pts = np.array(self.corners) + [0, 0, 0.008]
-        ring = np.vstack([pts, pts[:1]]) if len(pts) > 2 else pts
-        if len(ring) > 1:
-            self._polyline("/new_piece", ring, (200, 60, 20))
-        else:
-            scene.add_point_cloud("/new_piece", pts.astype(np.float32), (200, 60, 20), point_size=0.02)
-
-    def _new_pattern(self) -> None:
-        self._edit_pattern(self.editor.new)
-
-    def _close_piece(self) -> None:
-        if len(self.corners) < 3:
-            self.notify("A piece needs 3 corners", "Tick 'Draw a piece' and click its corners on the board.", "yellow")
-            return
-        cm = (np.array(self.corners)[:, :2]) / self.board.scale
-        self.corners = []
-        self._show_corners()
-        self._edit_pattern(lambda: self.editor.add_piece(cm))
-
-    def _piece_click_handler(self, piece: str):  # noqa: ANN202
-        def handler(event) -> None:  # noqa: ANN001
-            if not (self.sew_mode.value or self.point_mode.value):
-                return
-            hit = self.board.on_board(np.asarray(event.ray_origin), np.asarray(event.ray_direction))
-            if hit is None:
-                return
-            from ..pattern._types import EdgeRef
-
-            cm = self.board.to_piece(piece, hit[None])[0]
-            edge = EdgeRef(piece, self.editor.nearest_edge(piece, cm))
-            if self.point_mode.value:
-                self._edit_pattern(lambda: self.editor.insert_point(piece, edge.edge, cm))
-                return
-            if not self.sewing:
-                self.sewing = [edge]
-                self._status(f"Edge {edge} picked: click the edge to sew it to.")
-                return
-            first, self.sewing = self.sewing[0], []
-            self._edit_pattern(lambda: self.editor.sew(first, edge))
-
-        return handler
-
-    def _flip(self, piece: str) -> None:
-        """Turn a piece over (its back becomes its outside)."""
-        self._edit_pattern(lambda: self.editor.flip(piece))
-
-    def _download_pattern(self) -> None:
-        from ..pattern import save_pattern
-
-        with tempfile.TemporaryDirectory() as d:
-            path = Path(d) / f"{self.editor.pattern.name}.json"
-            save_pattern(self.editor.pattern, path)
-            self.client.send_file_download(path.name, path.read_bytes(), save_immediately=True)
-
-    def _status(self, extra: str = "") -> None:
+    def status_line(self, extra: str = "") -> None:
         s = self.session
         lines = [f"**{s.pattern.name}** on the body: {len(s.pairs)} stroke pair(s)."]
         if s.garment_pairs:
@@ -639,7 +412,7 @@ class ClientView:
             return
         title, body, color = done(result)
         self._job_ended(note, ticking, title, body, color)
-        self._status(body)
+        self.status_line(body)
 
     def _wrapped(self, garment) -> tuple[str, str, str]:  # noqa: ANN001 - a DressedGarment
         from ..dressing import target_misses
@@ -743,7 +516,7 @@ class ClientView:
             return
         if self.drawing is None or self.drawing.piece is not None:
             return
-        eye, direction = self._ray(event)
+        eye, direction = self.ray(event)
         hit = self._cloth_surface.cast(eye[None], direction[None], hit="first")
         if hit.hit.all():
             self.drawing.points.append(hit.points[0])
@@ -759,7 +532,7 @@ class ClientView:
     def _body_target(self, event) -> np.ndarray:  # noqa: ANN001
         """Where the pointer is on the body (its ray's first hit), or the body point nearest the pointer's place
         on the camera-facing plane when the ray misses the body."""
-        eye, direction = self._ray(event)
+        eye, direction = self.ray(event)
         hit = self.session.surface.cast(eye[None], direction[None], hit="first")
         if hit.hit.all():
             return hit.points[0]
@@ -848,6 +621,10 @@ class ClientView:
         if self._opened(event, (".json",), load, "Strokes not loaded"):
             self._redraw_strokes()
 
+    def pattern_edited(self, pattern) -> None:  # noqa: ANN001 - a Pattern
+        """The editor changed the pattern: the board rebuilt, the strokes that still lie on their pieces kept."""
+        self._replace(pattern=pattern, keep_editor=True)
+
     def _replace(self, *, body=None, pattern=None, keep_editor: bool = False) -> None:  # noqa: ANN001
         """A new body or pattern: a fresh session, the scene rebuilt. An edited pattern keeps the stroke pairs
         that still lie on its pieces; a new body or an opened pattern starts without strokes."""
@@ -859,7 +636,7 @@ class ClientView:
             self.session = DressingSession(body or s.body, pattern or s.pattern)
             self.notify("Strokes dropped", "the edit moved a piece a stroke was drawn on", "yellow")
         if not keep_editor:
-            self.editor = PatternEditor(self.session.pattern)
+            self.tools.editor = PatternEditor(self.session.pattern)
         self.board = BoardLayout.of(self.session.pattern)
         self.client.scene.reset()
         self._stroke_handles = []  # gone with the scene
@@ -869,10 +646,7 @@ class ClientView:
             current = self.flip_choice.value
             self.flip_choice.options = names
             self.flip_choice.value = current if current in names else names[-1]
-        if hasattr(self, "issues_md"):
-            found = [f"{i.severity}: {i.message}" for i in self.editor.issues()]
-            self.issues_md.content = "\n\n".join(found[:6]) if found else "No problems found in the pattern."
-            self.seam_choice.options = self._seam_names()
+        self.tools.refresh_panel()
         self._redraw_strokes()
 
     def _download_strokes(self) -> None:
