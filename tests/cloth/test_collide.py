@@ -116,6 +116,26 @@ def test_moved_body_keeps_tracking(sphere):
     assert state.contacts.distance[0] == pytest.approx(model.params.contact_offset_m, abs=2e-4)
 
 
+def test_a_moving_body_finds_the_same_nearest_points_without_a_tree(body, body_collider, rng):
+    """On a moved body (a simulation's every frame) a few global searches walk from the nearest body vertex
+    instead of building a search tree: the same nearest points as the tree's, on a real body, near and far."""
+    v = body.mesh.vertices
+    bent = v + np.c_[0.03 * np.sin(4 * v[:, 1]), 0.01 * np.ones(len(v)), 0.02 * np.cos(3 * v[:, 0])]  # another pose
+    moved = body_collider.moved(bent)
+    assert moved.moving and moved._surface is None
+    k = rng.choice(len(bent), 300, replace=False)
+    off = np.abs(rng.normal(size=(300, 1))) * rng.choice([0.002, 0.02, 0.1], size=(300, 1))  # near and far, outside
+    pts = bent[k] + moved.vertex_normals[k] * off + rng.normal(size=(300, 3)) * 0.003
+    model, state = point_cloud_model(pts)
+    assert track(model, state, moved) == len(pts)  # every vertex new: a global search each
+    assert moved._surface is None  # found without building the tree
+    _, _, exact = moved.nearest(pts)
+    err = np.abs(state.contacts.distance) - exact
+    assert err.min() > -1e-9  # never nearer than the true nearest point (it is a point of the surface)
+    # the same point for 97 % here; the others stop where the surface curves back (a walk's local nearest point)
+    assert (err < 1e-6).mean() > 0.95 and err.max() < 2e-3
+
+
 def test_collider_surface_is_built_once_and_shared(sphere, rng):
     """The wrap places its strokes with the collider's own Surface (one AABB tree per body, not one per wrap);
     a mesh in another pose gets a Surface of its own. `nearest` answers from the same tree."""

@@ -47,6 +47,8 @@ class BodyCollider:
     capsule_ends : (C, 2, 3) float64, metres; capsule_radii : (C, 2) float64, metres (tapered capsules).
     floor_y : height of the ground plane, metres, or None: cloth is kept above it (a long hem rests on the floor
         instead of hanging through it). `from_body` puts it under the feet.
+    moving : a pose of a moving body (made by `moved`): a few global searches walk from the nearest body vertex
+        instead of building a search tree for this pose alone.
     """
 
     vertices: np.ndarray
@@ -61,6 +63,7 @@ class BodyCollider:
     face_adjacency: np.ndarray = field(init=False, repr=False)
     faces_at_ptr: np.ndarray = field(init=False, repr=False)
     faces_at: np.ndarray = field(init=False, repr=False)
+    moving: bool = field(init=False, repr=False, default=False)
 
     @classmethod
     def from_mesh(
@@ -176,6 +179,7 @@ class BodyCollider:
         )
         out._set_capsule_box()
         out._surface = None
+        out.moving = True
         return out
 
     @property
@@ -200,6 +204,12 @@ class BodyCollider:
     def nearest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Global nearest-surface query (`surface`): face (n,) int64, point (n, 3), distance (n,)."""
         return self.surface.nearest(points)
+
+
+#: On a moving body's pose (`BodyCollider.moved`), up to this many vertices needing a global search are found by
+#: a walk from their nearest body vertex instead of the search tree (a brute-force pass over the body's vertices,
+#: against ~17 ms to build the tree on a 13,000-vertex body every frame); more, and the tree is built.
+SEEDED_SEARCH_MAX = 1000
 
 
 @dataclass
@@ -269,7 +279,8 @@ def track(model: ClothModel, state: ClothState, collider: BodyCollider, *, activ
     """Refresh the nearest body point of every active cloth vertex (in place on `state.contacts`).
 
     Each vertex walks from its tracked body face to neighbouring faces while the nearest point gets closer; new
-    vertices, failed walks and far vertices that may have come near the body get a global AABB search.
+    vertices, failed walks and far vertices that may have come near the body get a global search: the AABB tree,
+    or, on a moving body's pose (few of them), a walk from the nearest body vertex (`SEEDED_SEARCH_MAX`).
     Returns the number of global searches.
     """
     if not isinstance(collider, BodyCollider):
@@ -304,6 +315,9 @@ def track(model: ClothModel, state: ClothState, collider: BodyCollider, *, activ
         w["search"],
     )
     idx = np.flatnonzero(w["search"])
+    searched = len(idx)
+    if searched and collider.moving and collider._surface is None and searched <= SEEDED_SEARCH_MAX:
+        idx = _seeded_search(model, state, collider, idx, w)
     if len(idx):
         face, _, _ = collider.nearest(state.positions[idx])
         K.store_found(
@@ -324,7 +338,32 @@ def track(model: ClothModel, state: ClothState, collider: BodyCollider, *, activ
             c.anchor,
             c.anchor_distance,
         )
-    return len(idx)
+    return searched
+
+
+def _seeded_search(model: ClothModel, state: ClothState, collider: BodyCollider, idx: np.ndarray, w: dict):
+    """The global search for a few vertices on a body whose tree is not built (a moved body, every frame of a
+    simulation: building it cost 17 ms a frame, a third of the kimono's step): each vertex starts at a face of
+    its nearest body vertex and walks to its nearest point. Returns the vertices whose walk failed (they get the
+    tree)."""
+    c = state.contacts
+    face = np.empty(len(idx), dtype=np.int64)
+    K.seed_faces(state.positions, idx, collider.vertices, collider.faces, collider.faces_at_ptr, collider.faces_at,
+                 face)  # fmt: skip
+    args = (collider.vertices, collider.faces, collider.face_normals, collider.edge_normals)
+    normals = (collider.vertex_normals, collider.vertex_normals)
+    K.store_found(state.positions, idx, face, *args, *normals, c.face, c.bary, c.point, c.normal, c.distance,
+                  c.anchor, c.anchor_distance)  # fmt: skip
+    only = np.zeros(len(state.positions), dtype=bool)
+    only[idx] = True
+    p = model.params
+    K.walk_track(
+        state.positions, only, collider.vertices, collider.faces, collider.face_adjacency, collider.faces_at_ptr,
+        collider.faces_at, collider.face_normals, collider.edge_normals, collider.vertex_normals,
+        collider.vertex_normals, p.walk_max_steps, p.track_distance_m, p.contact_distance_m, c.face, c.bary,
+        c.point, c.normal, c.distance, c.anchor, c.anchor_distance, w["search"],
+    )  # fmt: skip
+    return np.flatnonzero(w["search"])
 
 
 def _layer_face_vertices(model: ClothModel, state: ClothState) -> np.ndarray:

@@ -288,6 +288,30 @@ def store_found(
 
 
 @njit(cache=True, parallel=PARALLEL)
+def seed_faces(pos, idx, bv, bf, vf_ptr, vf, out_face):
+    """For the vertices idx (n,): of the body faces around the body vertex nearest each (brute force over the
+    body's vertices), the one with the nearest point, in out_face (n,). A start for `walk_track`, which descends
+    from it to the nearest point."""
+    nb = bv.shape[0]
+    for j in prange(idx.shape[0]):
+        i = idx[j]
+        px, py, pz = pos[i, 0], pos[i, 1], pos[i, 2]
+        best, bd2 = 0, np.inf
+        for v in range(nb):
+            d2 = (bv[v, 0] - px) ** 2 + (bv[v, 1] - py) ** 2 + (bv[v, 2] - pz) ** 2
+            if d2 < bd2:
+                best, bd2 = v, d2
+        face, fd2 = 0, np.inf
+        for k in range(vf_ptr[best], vf_ptr[best + 1]):
+            g = vf[k]
+            qx, qy, qz, _, _, _, _ = closest_on_triangle(px, py, pz, bv, bf[g, 0], bf[g, 1], bf[g, 2])
+            e2 = (px - qx) ** 2 + (py - qy) ** 2 + (pz - qz) ** 2
+            if e2 < fd2:
+                face, fd2 = g, e2
+        out_face[j] = face
+
+
+@njit(cache=True, parallel=PARALLEL)
 def push_out(pos, movable, offset, c_face, c_normal, c_dist):
     """Move each movable tracked vertex closer to the body than `offset` (or inside) along the interpolated body
     normal until it is `offset` outside (in place; updates c_dist). Returns (vertices moved, deepest depth inside
