@@ -62,6 +62,7 @@ class ClientView:
         self.outcome = ""
         self.jobs_done = 0
         self._build_panel()
+        self.tools.refresh_panel()
         self._build_scene()
         self._redraw_strokes()
         client.scene.on_click()(self.tools.scene_clicked)  # corners of a piece being drawn (once: scenes are rebuilt)
