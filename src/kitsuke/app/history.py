@@ -21,15 +21,15 @@ class History(Generic[T]):
         self.now = state
 
     def undo(self) -> bool:
-        if not self._undo:
-            return False
-        self._redo.append(self.now)
-        self.now = self._undo.pop()
-        return True
+        return self._move(self._undo, self._redo)
 
     def redo(self) -> bool:
-        if not self._redo:
+        return self._move(self._redo, self._undo)
+
+    def _move(self, src: list[T], dst: list[T]) -> bool:
+        """The last state of `src` made current, the current one kept on `dst`; False when `src` is empty."""
+        if not src:
             return False
-        self._undo.append(self.now)
-        self.now = self._redo.pop()
+        dst.append(self.now)
+        self.now = src.pop()
         return True

@@ -61,6 +61,9 @@ class ClientView:
         self.busy = False
         self.outcome = ""
         self.jobs_done = 0
+        self.dragging = None  # the DragSession of the garment dressed last (with drag_history, dragger)
+        self._syncing = False
+        self._stroke_handles: list = []
         self._build_panel()
         self.tools.refresh_panel()
         self._build_scene()
@@ -130,11 +133,11 @@ class ClientView:
         return chosen
 
     def _redraw_strokes(self) -> None:
-        if getattr(self, "_syncing", False):
+        if self._syncing:
             return
         chosen = self._sync_pair_choice()
         scene = self.client.scene
-        for handle in getattr(self, "_stroke_handles", []):
+        for handle in self._stroke_handles:
             handle.remove()
         self._stroke_handles = []
         s = self.session
@@ -311,7 +314,7 @@ class ClientView:
             gui.add_button("Save drags (JSON)").on_click(lambda _: self._download_drags())
 
     def _unpin_all(self) -> None:
-        if getattr(self, "dragging", None) is not None and not self.dragger.busy:
+        if self.dragging is not None and not self.dragger.busy:
             self.drag_history.unpin_all()
             self._show_pins()
 
@@ -367,7 +370,7 @@ class ClientView:
         )  # fmt: skip
 
     def _start_rewrap(self) -> None:
-        s, d = self.session, getattr(self, "dragging", None)
+        s, d = self.session, self.dragging
         if d is None or not s.garment_pairs:
             self.notify("Nothing to re-wrap", "Wrap first; then draw a stroke on the pattern and where it should "
                         "go on the garment (Draw on the garment ticked).", "yellow")  # fmt: skip
@@ -462,7 +465,7 @@ class ClientView:
         from ..metrics import QualityTargets, vertex_strain
         from .strain_map import strain_colors
 
-        d = getattr(self, "dragging", None)
+        d = self.dragging
         if d is None:
             return
         on = self.strain_box.value and d.grabbed is None
@@ -554,7 +557,7 @@ class ClientView:
         self._show_pins()
 
     def _drag_history(self, undo: bool) -> None:
-        if getattr(self, "dragging", None) is None or self.dragger.busy:
+        if self.dragging is None or self.dragger.busy:
             return
         if self.drag_history.undo() if undo else self.drag_history.redo():
             self.push_positions()
@@ -650,6 +653,12 @@ class ClientView:
         self.tools.refresh_panel()
         self._redraw_strokes()
 
+    def _dressed(self, hint: str) -> bool:
+        """Whether a garment is dressed; if not, the user is told `hint`."""
+        if self.dragging is None:
+            self.notify("Nothing dressed yet", hint, "yellow")
+        return self.dragging is not None
+
     def _download_strokes(self) -> None:
         from ..dressing import strokes_to_json
 
@@ -661,8 +670,7 @@ class ClientView:
         """The pins and drags made so far, as a drags file that `kitsuke drag --drags` replays."""
         from ..dressing import drags_to_json
 
-        if getattr(self, "dragging", None) is None:
-            self.notify("Nothing dressed yet", "Wrap, pin and drag first, then save the drags.", "yellow")
+        if not self._dressed("Wrap, pin and drag first, then save the drags."):
             return
         self.client.send_file_download(
             "drags.json", drags_to_json(self.drag_history.drags()).encode(), save_immediately=True
@@ -673,8 +681,7 @@ class ClientView:
         from .._files import write_json_atomic
         from ..dressing.export import write_garment_glb, write_garment_obj
 
-        if getattr(self, "dragging", None) is None:
-            self.notify("Nothing dressed yet", "Wrap first, then save the garment.", "yellow")
+        if not self._dressed("Wrap first, then save the garment."):
             return
         garment, body = self.dragging.garment(), self.session.body.mesh
         with tempfile.TemporaryDirectory() as d:

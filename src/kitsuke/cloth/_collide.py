@@ -286,83 +286,53 @@ def track(model: ClothModel, state: ClothState, collider: BodyCollider, *, activ
     if not isinstance(collider, BodyCollider):
         raise InputError("collider must be a BodyCollider")
     state.check(model)
-    p = model.params
-    c = state.contacts
     act = vertex_active(model, state) if active is None else active
     w = _buffers(state)
-    K.walk_track(
-        state.positions,
-        act,
-        collider.vertices,
-        collider.faces,
-        collider.face_adjacency,
-        collider.faces_at_ptr,
-        collider.faces_at,
-        collider.face_normals,
-        collider.edge_normals,
-        collider.vertex_normals,
-        collider.vertex_normals,
-        p.walk_max_steps,
-        p.track_distance_m,
-        p.contact_distance_m,
-        c.face,
-        c.bary,
-        c.point,
-        c.normal,
-        c.distance,
-        c.anchor,
-        c.anchor_distance,
-        w["search"],
-    )
+    _walk(model, state, collider, act, w["search"])
     idx = np.flatnonzero(w["search"])
     searched = len(idx)
     if searched and collider.moving and collider._surface is None and searched <= SEEDED_SEARCH_MAX:
         idx = _seeded_search(model, state, collider, idx, w)
     if len(idx):
         face, _, _ = collider.nearest(state.positions[idx])
-        K.store_found(
-            state.positions,
-            idx,
-            face,
-            collider.vertices,
-            collider.faces,
-            collider.face_normals,
-            collider.edge_normals,
-            collider.vertex_normals,
-            collider.vertex_normals,
-            c.face,
-            c.bary,
-            c.point,
-            c.normal,
-            c.distance,
-            c.anchor,
-            c.anchor_distance,
-        )
+        _store_found(state, collider, idx, face)
     return searched
+
+
+def _walk(model: ClothModel, state: ClothState, collider: BodyCollider, active: np.ndarray, search: np.ndarray) -> None:
+    """`K.walk_track` for the `active` vertices: contacts refreshed in place, `search` set where a global search
+    is needed."""
+    p, c = model.params, state.contacts
+    K.walk_track(
+        state.positions, active, collider.vertices, collider.faces, collider.face_adjacency, collider.faces_at_ptr,
+        collider.faces_at, collider.face_normals, collider.edge_normals, collider.vertex_normals,
+        collider.vertex_normals, p.walk_max_steps, p.track_distance_m, p.contact_distance_m, c.face, c.bary,
+        c.point, c.normal, c.distance, c.anchor, c.anchor_distance, search,
+    )  # fmt: skip
+
+
+def _store_found(state: ClothState, collider: BodyCollider, idx: np.ndarray, face: np.ndarray) -> None:
+    """The contacts of vertices idx from their nearest body faces (a global search's answer), anchored there."""
+    c = state.contacts
+    K.store_found(
+        state.positions, idx, face, collider.vertices, collider.faces, collider.face_normals, collider.edge_normals,
+        collider.vertex_normals, collider.vertex_normals, c.face, c.bary, c.point, c.normal, c.distance, c.anchor,
+        c.anchor_distance,
+    )  # fmt: skip
 
 
 def _seeded_search(model: ClothModel, state: ClothState, collider: BodyCollider, idx: np.ndarray, w: dict):
     """The global search for a few vertices on a body whose tree is not built (a moved body, every frame of a
-    simulation: building it cost 17 ms a frame, a third of the kimono's step): each vertex starts at a face of
-    its nearest body vertex and walks to its nearest point. Returns the vertices whose walk failed (they get the
-    tree)."""
-    c = state.contacts
+    simulation: building it cost 17 ms a frame, a third of the kimono's step): each vertex starts at the best face
+    around its nearest body vertex and walks to its nearest point. Returns the vertices whose walk failed (they get
+    the tree)."""
     face = np.empty(len(idx), dtype=np.int64)
     K.seed_faces(state.positions, idx, collider.vertices, collider.faces, collider.faces_at_ptr, collider.faces_at,
                  face)  # fmt: skip
-    args = (collider.vertices, collider.faces, collider.face_normals, collider.edge_normals)
-    normals = (collider.vertex_normals, collider.vertex_normals)
-    K.store_found(state.positions, idx, face, *args, *normals, c.face, c.bary, c.point, c.normal, c.distance,
-                  c.anchor, c.anchor_distance)  # fmt: skip
+    _store_found(state, collider, idx, face)
     only = np.zeros(len(state.positions), dtype=bool)
     only[idx] = True
-    p = model.params
-    K.walk_track(
-        state.positions, only, collider.vertices, collider.faces, collider.face_adjacency, collider.faces_at_ptr,
-        collider.faces_at, collider.face_normals, collider.edge_normals, collider.vertex_normals,
-        collider.vertex_normals, p.walk_max_steps, p.track_distance_m, p.contact_distance_m, c.face, c.bary,
-        c.point, c.normal, c.distance, c.anchor, c.anchor_distance, w["search"],
-    )  # fmt: skip
+    _walk(model, state, collider, only, w["search"])
     return np.flatnonzero(w["search"])
 
 
