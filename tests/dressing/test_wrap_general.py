@@ -87,6 +87,19 @@ def test_strokes_that_no_garment_can_meet_raise_and_name_what_failed(sphere):
     assert wrap(sphere, _square(), strokes, params=PARAMS, check=False).n_vertices == garment.n_vertices
 
 
+def test_cloth_flung_far_from_the_body_is_not_a_garment(drawn_up):
+    """A garment on the body but for one flap half a metre off it (found written with exit 0 on a corpus design)."""
+    import copy
+
+    flung = copy.copy(drawn_up)
+    flung.positions = drawn_up.positions.copy()
+    centre = flung.positions.mean(axis=0)
+    flung.positions[0] = centre + 0.9 * (flung.positions[0] - centre) / np.linalg.norm(flung.positions[0] - centre)
+    failures = on_body_failures(flung, _sphere(0.3))
+    assert failures[0].startswith("piece square: cloth 60 cm from the body")  # (and torn, where it was pulled)
+    assert on_body_failures(drawn_up, _sphere(0.3)) == []
+
+
 def test_a_garment_on_the_body_reports_the_targets_it_misses(drawn_up):
     assert on_body_failures(drawn_up, _sphere(0.3)) == []
     strict = QualityTargets(max_strain=1e-4, stroke_residual_mm=0.1)

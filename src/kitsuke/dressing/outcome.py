@@ -20,6 +20,9 @@ from ..metrics import QualityTargets
 
 #: A piece whose nearest vertex lies farther than this from the body is off the body, metres.
 OFF_BODY_M = 0.10
+#: Cloth farther than this from the body is not worn, metres (the demo kimono's sleeves hang at most 22 cm off
+#: it; a flap of a failed wrap was found 63 cm off, written with exit 0, on corpus seed 4179).
+FAR_CLOTH_M = 0.50
 #: An edge longer than (1 + this) times its rest length is torn.
 TORN_STRAIN = 1.0
 #: A stroke whose cloth lies farther than this from its body stroke has left where it was drawn, metres.
@@ -52,6 +55,13 @@ def on_body_failures(garment, body, *, surface: Surface | None = None) -> list[s
         d = dist[piece == k]
         if len(d) and d.min() > OFF_BODY_M:
             out.append(f"piece {name} lies {100 * d.min():.0f} cm off the body")
+    far = int(np.argmax(dist)) if len(dist) else -1
+    if far >= 0 and dist[far] > FAR_CLOTH_M and not out:
+        k = piece[far]
+        out.append(
+            f"piece {garment.piece_names[k] if k >= 0 else '?'}: cloth {100 * dist[far]:.0f} cm from the body at "
+            f"({', '.join(f'{c:.2f}' for c in pos[far])}) m"
+        )
     m = garment.model
     e = m.edges
     length = np.linalg.norm(pos[e[:, 0]] - pos[e[:, 1]], axis=1)
