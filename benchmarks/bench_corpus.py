@@ -214,7 +214,13 @@ def main() -> None:
     ap.add_argument("--drag", action="store_true", help="also lift each dressed garment 5 cm and release it")
     ap.add_argument("--json", help="write the rows here")
     ap.add_argument("--keep", help="keep the sampled designs in this folder (reused when already there)")
-    ap.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE", help="WrapParams to change (Python values)")
+    ap.add_argument(
+        "--set",
+        nargs="*",
+        default=[],
+        metavar="NAME=VALUE",
+        help="wrap settings to change by dotted name, e.g. polish.rounds=0 (Python values)",
+    )
     ap.add_argument("--only", nargs="*", default=None, help="dress only designs whose name contains one of these")
     ap.add_argument("--sampler", type=Path, default=SAMPLER, help="GarmentCode's sampler (default: %(default)s)")
     ap.add_argument("--batch", choices=["local", "ray"], help="dress them as one kitsuke.batch batch on this runner")
@@ -230,7 +236,7 @@ def main() -> None:
     from kitsuke.dressing import WrapParams
 
     changes = {k: ast.literal_eval(v) for k, v in (a.split("=", 1) for a in args.set)}
-    params = WrapParams(**changes)
+    params = WrapParams().changed(changes)
 
     body = load_body(BODY)
     collider = BodyCollider.from_body(body)

@@ -8,7 +8,6 @@ Prints the per-step timings of each run after a warm-up run (numba compilation, 
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import time
 from pathlib import Path
 
@@ -20,9 +19,9 @@ ROOT = Path(__file__).resolve().parents[1]
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--settle", choices=["jacobi", "global"], default="jacobi", help="WrapParams.settle")
+    ap.add_argument("--settle", choices=["jacobi", "global"], default="jacobi", help="SettleSettings.method")
     ap.add_argument(
-        "--polish-rounds", type=int, default=None, help="WrapParams.polish_rounds (default: the wrap's; 0: no polish)"
+        "--polish-rounds", type=int, default=None, help="PolishSettings.rounds (default: the wrap's; 0: no polish)"
     )
     args = ap.parse_args()
     from kitsuke.body import load_body
@@ -37,9 +36,11 @@ def main() -> None:
     pm = mesh_pattern(pattern, edge_length=1.5)
     collider = BodyCollider.from_body(body)
     resolved = resolve_strokes(strokes, pattern, collider.surface, pattern_mesh=pm)
-    params = WrapParams() if args.settle == "jacobi" else WrapParams(settle="global", settle_iterations=30)
+    params = WrapParams()
+    if args.settle == "global":
+        params = params.changed({"settle.method": "global", "settle.iterations": 30})
     if args.polish_rounds is not None:
-        params = dataclasses.replace(params, polish_rounds=args.polish_rounds)
+        params = params.changed({"polish.rounds": args.polish_rounds})
     wrap(body, pm, resolved, collider=collider, params=params, report=False)  # warm-up
     walls = []
     for _ in range(args.repeat):

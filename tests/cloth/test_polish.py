@@ -228,18 +228,16 @@ def test_bad_arguments_are_rejected():
         polish(model, state, floor_collider(), iterations=0)
     with pytest.raises(InputError):
         polish(model, state, None)
-    from kitsuke.dressing import WrapParams
+    from kitsuke.dressing import PolishSettings, WrapParams
 
-    with pytest.raises(InputError):
-        WrapParams(polish_iterations=0)
-    with pytest.raises(InputError):
-        WrapParams(polish_rounds=-1)
-    for bad in (dict(polish_refine_levels=-1), dict(polish_refine_iterations=0), dict(polish_limit_sweeps=-1)):
-        with pytest.raises(InputError, match="polish"):
-            WrapParams(**bad)
+    for bad in ({"iterations": 0}, {"rounds": -1}, {"levels": -1}, {"refine_iterations": 0}, {"limit_sweeps": -1}):
+        with pytest.raises(InputError, match="PolishSettings"):
+            PolishSettings(**bad)
+        with pytest.raises(InputError, match="PolishSettings"):
+            WrapParams().changed({f"polish.{k}": v for k, v in bad.items()})
     for limit in (-0.01, 1.0, float("nan")):
-        with pytest.raises(InputError, match="polish_strain_limit"):
-            WrapParams(polish_strain_limit=limit)
+        with pytest.raises(InputError, match="strain_limit"):
+            WrapParams().changed({"polish.strain_limit": limit})
     with pytest.raises(InputError, match="levels"):
         polish_refined(model, state, floor_collider(), levels=-1)
     with pytest.raises(InputError, match="strain_limit"):

@@ -73,7 +73,7 @@ def test_the_shirt_at_2_cm_keeps_its_sleeve_round_the_arm():
     """At 2 cm the close leaves the right sleeve caught round the arm (measured: edges at 5x their length, and 433 %
     max strain after the whole wrap without mending); the mend finds those edges and regrows the cloth, after which
     none is torn. The regrown sleeve settles 3 cm from its stroke: held there, the shirt ends at 45 % max strain;
-    let go (`WrapParams.tether_strain`), at 4.5 %, its strokes reported loose (measured 2026-11-26)."""
+    let go (`TetherSettings.strain`), at 4.5 %, its strokes reported loose (measured 2026-11-26)."""
     body = load_body(ROOT / "tests" / "data" / "bodies" / "mean_all.obj")
     pattern = load_pattern(ROOT / "tests" / "data" / "pattern" / "shirt_mean_specification.json")
     strokes = read_strokes(ROOT / "src" / "kitsuke" / "assets" / "strokes" / "shirt_mean_all.json")
@@ -89,6 +89,6 @@ def test_the_shirt_at_2_cm_keeps_its_sleeve_round_the_arm():
 def test_bad_mend_params():
     for value in (0.0, -1.0, float("nan")):
         with pytest.raises(InputError, match="tear_strain"):
-            WrapParams(tear_strain=value)
+            WrapParams().changed({"close.tear_strain": value})
     with pytest.raises(InputError, match="mend_rounds"):
-        WrapParams(mend_rounds=-1)
+        WrapParams().changed({"close.mend_rounds": -1})

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from kitsuke.body import default_body, load_body
-from kitsuke.dressing import check_strokes, load_packaged_strokes
+from kitsuke.dressing import TetherSettings, check_strokes, load_packaged_strokes
 from kitsuke.dressing.wrap import DressedGarment, WrapParams, wrap
 from kitsuke.pattern import load_pattern
 
@@ -125,7 +125,7 @@ def test_without_tethers_the_garment_settles_away_from_its_strokes():
         default_body(),
         load_pattern(case.pattern),
         load_packaged_strokes(case.strokes),
-        params=WrapParams(stroke_reach_m=None),
+        params=WrapParams(tethers=TetherSettings(reach_m=None)),
     )
     assert g.max_stroke_residual_m > 0.012
     assert g.report.penetration_count == 0 and g.report.inverted_count == 0

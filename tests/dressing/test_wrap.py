@@ -11,7 +11,7 @@ import pytest
 
 from kitsuke.body import load_body
 from kitsuke.cloth import ClothModel, ClothParams, ClothState, relax
-from kitsuke.dressing import BodyStroke, PatternStroke, StrokePair, Strokes, read_strokes
+from kitsuke.dressing import BodyStroke, GrowSettings, PatternStroke, SettleSettings, StrokePair, Strokes, read_strokes
 from kitsuke.dressing._grow import grow, unfold
 from kitsuke.dressing._place import _extended_coordinates
 from kitsuke.dressing._solve import GlobalRelax
@@ -265,7 +265,12 @@ def test_wrap_sheet_on_sphere():
     on its body stroke (within 1 cm). Measured: strain mean 1.1 %, max 22 % (a flat square cannot lie on a
     sphere without strain where its corners fold), no inverted triangle (one in a corner fold before untangling)."""
     sphere = _sphere(0.3)
-    g = wrap(sphere, _square(), _sheet_strokes(0.3), params=WrapParams(edge_length_cm=2.0, settle_iterations=40))
+    g = wrap(
+        sphere,
+        _square(),
+        _sheet_strokes(0.3),
+        params=WrapParams(edge_length_cm=2.0, settle=SettleSettings(iterations=40)),
+    )
     assert isinstance(g, DressedGarment)
     r = g.report
     assert r.penetration_count == 0 and r.inverted_count == 0 and r.seam_gap_mm == 0.0
@@ -288,9 +293,9 @@ def test_global_settle_strains_the_shirt_less(shirt):
     follow either settle: the same shirt, less strained than after the Jacobi settle (measured 2026-11-24: 1.8 %
     against 2.6 % mean), still outside the body and without folded triangles."""
     body, pattern, strokes = load_body(MEAN_ALL), load_pattern(SHIRT), read_strokes(SHIRT_STROKES)
-    bare = dict(finish_iterations=0, length_sweeps=0, polish_rounds=0)
-    jacobi = wrap(body, pattern, strokes, params=WrapParams(**bare))
-    g = wrap(body, pattern, strokes, params=WrapParams(settle="global", settle_iterations=30, **bare))
+    bare = WrapParams().changed({"lengths.finish_iterations": 0, "lengths.sweeps": 0, "polish.rounds": 0})
+    jacobi = wrap(body, pattern, strokes, params=bare)
+    g = wrap(body, pattern, strokes, params=bare.changed({"settle.method": "global", "settle.iterations": 30}))
     r = g.report
     assert r.strain_mean < jacobi.report.strain_mean - 0.002
     assert r.penetration_count == 0 and r.inverted_count == 0 and r.seam_gap_mm == 0.0
@@ -398,14 +403,16 @@ def test_kimono_params():
 
     b = default_body()
     p = kimono_params(b)
-    assert p.hang == KIMONO_HANG and p.hold_band_m == obi_band(b)
+    assert p.grow.hang == KIMONO_HANG and p.settle.hold_band_m == obi_band(b)
     assert p.cloth.contact_offset_m == KIMONO_OFFSET_M > WrapParams().cloth.contact_offset_m  # over an under-kimono
     # The polish is the wrap's own (its layers now hold, so it is kept: 4.8 % max strain where it was 37 %).
-    assert (p.polish_passes, p.polish_refine_levels) == (WrapParams().polish_passes, WrapParams().polish_refine_levels)
-    assert kimono_params(b, WrapParams(hang=1.0)).hang == 1.0
-    assert kimono_params(b, WrapParams(hang=1.0), hang=0.0).hang == 0.0
-    assert kimono_params(b, WrapParams(hold_band_m=(0.5, 0.6))).hold_band_m == (0.5, 0.6)
-    assert kimono_params(b.mesh).hold_band_m is None
+    assert p.polish == WrapParams().polish
+    hung = WrapParams(grow=GrowSettings(hang=1.0))
+    assert kimono_params(b, hung).grow.hang == 1.0
+    assert kimono_params(b, hung, hang=0.0).grow.hang == 0.0
+    banded = WrapParams(settle=SettleSettings(hold_band_m=(0.5, 0.6)))
+    assert kimono_params(b, banded).settle.hold_band_m == (0.5, 0.6)
+    assert kimono_params(b.mesh).settle.hold_band_m is None
     assert is_kimono(make_kimono()) and not is_kimono(load_pattern(SHIRT))
 
 
@@ -426,42 +433,38 @@ def test_wrap_rejects_a_missing_piece_and_bad_params():
     )
     with pytest.raises(InputError, match="nope"):
         wrap(_sphere(), _square(), bad)
-    with pytest.raises(InputError):
-        WrapParams(rings_per_relax=0)
-    with pytest.raises(InputError, match="close_cg_iterations"):
-        WrapParams(close_cg_iterations=0)
-    with pytest.raises(InputError):
-        WrapParams(hold_band_m=(1.0, 0.9))
-    with pytest.raises(InputError, match="stroke_hold"):
-        WrapParams(stroke_hold=-0.1)
-    with pytest.raises(InputError, match="untangle_rounds"):
-        WrapParams(untangle_rounds=-1)
-    with pytest.raises(InputError, match="settle"):
-        WrapParams(settle="verlet")
-    with pytest.raises(InputError, match="stick_weight"):
-        WrapParams(stick_weight=-1.0)
-    with pytest.raises(InputError, match="length_sweeps"):
-        WrapParams(length_sweeps=-1)
-    for omega in (0.5, 2.0, float("nan")):
-        with pytest.raises(InputError, match="length_over_relaxation"):
-            WrapParams(length_over_relaxation=omega)
-    for rho in (0.0, 1.0, float("nan")):
-        with pytest.raises(InputError, match="length_chebyshev_rho"):
-            WrapParams(length_chebyshev_rho=rho)
+    # Each setting checked in its group, named as the group and field.
+    bad_settings = {
+        "grow.rings_per_relax": 0,
+        "close.cg_iterations": 0,
+        "settle.hold_band_m": (1.0, 0.9),
+        "close.stroke_hold": -0.1,
+        "untangle.rounds": -1,
+        "settle.method": "verlet",
+        "settle.stick_weight": -1.0,
+        "lengths.sweeps": -1,
+        "settle.hold_reach_m": 0.0,
+        "untangle.bend": -0.1,
+        "lengths.collide_every": 0,
+        "grow.hang_clearance_m": -0.01,
+    }
+    bad_settings |= {f"lengths.over_relaxation={v}": v for v in (0.5, 2.0, float("nan"))}
+    bad_settings |= {f"lengths.chebyshev_rho={v}": v for v in (0.0, 1.0, float("nan"))}
+    bad_settings |= {f"tethers.reach_m={v}": v for v in (0.0, -0.01, float("nan"))}
+    bad_settings |= {f"grow.hang={v}": v for v in (-1.0, float("nan"))}
+    for key, value in bad_settings.items():
+        name = key.split("=")[0]
+        field = name.split(".")[1]
+        with pytest.raises(InputError, match=rf"{field}"):
+            WrapParams().changed({name: value})
     with pytest.raises(InputError, match="hold_reach_m"):
-        WrapParams(hold_reach_m=0.0)
-    with pytest.raises(InputError, match="hold_reach_m"):
-        WrapParams.strokes_held(hold_reach_m=float("nan"))
-    for reach in (0.0, -0.01, float("nan")):
-        with pytest.raises(InputError, match="stroke_reach_m"):
-            WrapParams(stroke_reach_m=reach)
-    with pytest.raises(InputError, match="untangle_bend"):
-        WrapParams(untangle_bend=-0.1)
-    with pytest.raises(InputError, match="length_collide_every"):
-        WrapParams(length_collide_every=0)
-    for bad in (dict(hang=-1.0), dict(hang=float("nan")), dict(hang_clearance_m=-0.01)):
-        with pytest.raises(InputError, match="hang"):
-            WrapParams(**bad)
+        WrapParams.strokes_held(settle=SettleSettings(hold_reach_m=float("nan")))
+    with pytest.raises(InputError, match="no wrap setting 'polish.roundz'"):
+        WrapParams().changed({"polish.roundz": 1})
+    with pytest.raises(InputError, match="no wrap setting 'glow.hang'"):
+        WrapParams().changed({"glow.hang": 1})
+    with pytest.raises(InputError, match="WrapParams.close must be a CloseSettings"):
+        WrapParams(close=3)
     with pytest.raises(InputError, match="no strokes"):
         wrap(_sphere(), _square(), Strokes([]))
     garment_target = Strokes(_sheet_strokes(0.3).pairs, target="garment")

@@ -9,6 +9,7 @@ import pytest
 from kitsuke.dressing import (
     BodyStroke,
     PatternStroke,
+    SettleSettings,
     StrokePair,
     Strokes,
     WrapParams,
@@ -21,7 +22,7 @@ from kitsuke.metrics import QualityTargets
 
 from .test_wrap import _sphere, _square
 
-PARAMS = WrapParams(edge_length_cm=2.0, settle_iterations=40)
+PARAMS = WrapParams(edge_length_cm=2.0, settle=SettleSettings(iterations=40))
 
 
 def _meridian(radius_m: float, length_m: float, up: bool = True) -> np.ndarray:

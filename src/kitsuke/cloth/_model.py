@@ -478,6 +478,15 @@ class ClothState:
         if not self.positions.flags.c_contiguous or self.positions.dtype != np.float64:
             self.positions = np.ascontiguousarray(self.positions, dtype=np.float64)
 
+    def holding(self, pinned: np.ndarray) -> ClothState:
+        """This state with other pins: `pinned` (V,) bool held where they are instead of `self.pinned`. It shares
+        everything else (positions, contacts, velocities, buffers), so a stage run on it moves this state's cloth
+        while this state's own pins stay as they are: how a pipeline passes each stage its pins."""
+        held = np.asarray(pinned, dtype=bool)
+        if held.shape != self.pinned.shape:
+            raise InputError(f"pinned must have shape {self.pinned.shape}, got {held.shape}")
+        return ClothState(self.positions, held, self.face_active, self.contacts, self.velocities, self._work)
+
     def copy(self) -> ClothState:
         c = Contacts(*(getattr(self.contacts, f.name).copy() for f in fields(Contacts)))
         v = None if self.velocities is None else self.velocities.copy()

@@ -334,11 +334,9 @@ def polish_refined(
         # it move.
         local = np.concatenate([near, np.ones(model.n_vertices - len(near), dtype=bool)])
         local = grow_region(model.faces, local, LOCAL_RINGS)
-        held = state.pinned
-        state.pinned = held | ~local
-        more = polish(model, state, collider, rounds=rounds, iterations=refine_iterations, tethers=tethers)
-        limit(model, state, between)
-        state.pinned = held
+        around = state.holding(state.pinned | ~local)
+        more = polish(model, around, collider, rounds=rounds, iterations=refine_iterations, tethers=tethers)
+        limit(model, around, between)
         stats.rounds += more.rounds
         stats.iterations += more.iterations
         stats.energy, stats.folded = more.energy, more.folded

@@ -141,18 +141,15 @@ def untangle(
         moved |= free
         if stats.rounds >= min(SMOOTH_AFTER, rounds // 2):  # relaxing alone did not open it: flatten it first
             _smooth(model, state.positions, grow_region(model.faces, seed, 1) & ~pinned, SMOOTH_PASSES)
-        state.pinned = ~free
-        try:
-            if tethers is None or not len(tethers):
-                relax(local, state, collider, iterations=iterations)
-            else:
-                for chunk in np.array_split(np.arange(iterations), TETHER_CHUNKS):
-                    relax(local, state, collider, iterations=len(chunk))
-                    for _ in range(TETHER_PASSES):  # points sharing a vertex move each other: a few passes
-                        if not tethers.project(state.positions, free):
-                            break
-        finally:
-            state.pinned = pinned
+        region = state.holding(~free)
+        if tethers is None or not len(tethers):
+            relax(local, region, collider, iterations=iterations)
+        else:
+            for chunk in np.array_split(np.arange(iterations), TETHER_CHUNKS):
+                relax(local, region, collider, iterations=len(chunk))
+                for _ in range(TETHER_PASSES):  # points sharing a vertex move each other: a few passes
+                    if not tethers.project(state.positions, free):
+                        break
         stats.rounds += 1
         folded = folded_faces(model, state)
     stats.after = int(folded.sum())

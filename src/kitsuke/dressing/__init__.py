@@ -22,6 +22,7 @@
 from importlib import resources
 from pathlib import Path
 
+from ._polish_step import PolishSettings
 from ._polyline import (
     arc_length,
     arc_parameters,
@@ -70,6 +71,14 @@ from .strokes import (
 )
 from .suggest import SuggestParams, suggest_strokes
 from .wrap import DressedGarment, WrapParams, wrap
+from .wrap_settings import (
+    CloseSettings,
+    GrowSettings,
+    LengthSettings,
+    SettleSettings,
+    TetherSettings,
+    UntangleSettings,
+)
 
 
 def packaged_strokes_path(name: str = "kimono_default") -> Path:
@@ -112,6 +121,13 @@ __all__ = [
     "write_drags",
     "DressedGarment",
     "WrapParams",
+    "GrowSettings",
+    "CloseSettings",
+    "SettleSettings",
+    "LengthSettings",
+    "TetherSettings",
+    "UntangleSettings",
+    "PolishSettings",
     "wrap",
     "FORMAT",
     "MAX_SURFACE_DISTANCE_M",

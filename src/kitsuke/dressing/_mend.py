@@ -12,7 +12,7 @@ closed cloth around it, which now lies where it should, and closes again. At the
 over twice its length after the close (the worst is 83 %, the hoody), so the mend leaves them untouched. Measured
 (max strain of the finished wrap, without -> with): the shirt at 1 cm 774 -> 40 %, at 2 cm 433 -> 37 %. (The
 kimono's long sleeves at 2-2.5 cm, grown straight on, caught on the forearm again when regrown; grown hanging,
-`WrapParams.hang`, they do not tear.) The cloth is regrown by the wrap's own growth (`grow_back`), so it hangs
+`GrowSettings.hang`, they do not tear.) The cloth is regrown by the wrap's own growth (`grow_back`), so it hangs
 where the first growth would have made it hang.
 """
 

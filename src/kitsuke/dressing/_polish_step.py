@@ -26,6 +26,7 @@ from ..cloth import (
     untangle,
 )
 from ..cloth._polish import cap_strain
+from ..errors import InputError
 from ..metrics import layer_crossing_mm, strain
 
 #: What the polish must not make worse than this, if it was better (issue 3's targets: mean strain 1 %, stroke
@@ -36,10 +37,11 @@ POLISH_RESIDUAL_M = 0.01
 
 @dataclass(frozen=True)
 class PolishSettings:
-    """How to polish; see `kitsuke.cloth.polish_refined` (levels 0: the topology stays). untangle_rounds,
-    untangle_bend, untangle_iterations, untangle_rings : `kitsuke.cloth.untangle` after it (0 rounds: none;
-    iterations None: its default). The untangle presses the cloth round a fold flat, so it starts 1 ring round
-    each (the kimono's last three folds at a sleeve's elbow: opened at 20 % max strain from 1 ring, 40 % from 3)."""
+    """How to polish; see `kitsuke.cloth.polish_refined` (rounds 0: no polish; levels 0: the topology stays;
+    strain_limit, limit_sweeps: its strain-limit sweeps). untangle_rounds, untangle_bend, untangle_iterations,
+    untangle_rings : `kitsuke.cloth.untangle` after it (0 rounds: none; iterations None: its default); it presses
+    the cloth round a fold flat, so it starts 1 ring round each. passes : most passes (the wrap's: a later one
+    only while the max strain is over 5 %, from the better cloth the last one kept)."""
 
     rounds: int = 8
     iterations: int = 40
@@ -53,6 +55,18 @@ class PolishSettings:
     untangle_bend: float = 0.1
     untangle_iterations: int | None = None
     untangle_rings: int = 1
+    passes: int = 1
+
+    def __post_init__(self) -> None:
+        counts = ("rounds", "levels", "rings", "max_folds", "limit_sweeps", "untangle_rounds", "passes")
+        if any(getattr(self, name) < 0 for name in counts) or self.iterations < 1 or self.refine_iterations < 1:
+            raise InputError(
+                f"PolishSettings: {', '.join(counts)} >= 0, iterations and refine_iterations >= 1 required"
+            )
+        if self.strain_limit is not None and not 0.0 <= self.strain_limit < 1.0:
+            raise InputError("PolishSettings.strain_limit must be a strain in [0, 1) or None")
+        if not self.untangle_bend >= 0:
+            raise InputError("PolishSettings.untangle_bend must be >= 0")
 
 
 def is_better(

@@ -247,7 +247,7 @@ def gravity_settle(
     stretch the cloth hanging below what holds it, in proportion to the length that hangs (the kimono under its
     obi band: a row of edges 8-30 % long), which the wrap's finish only partly takes back. Here the solve is
     stiff everywhere at once, so cloth that hangs swings down without stretching. Measured on the four shipped
-    cases (mean edge strain, Jacobi -> global, see WrapParams.settle): shirt 1.43 -> 1.36 %, hoody 1.51 ->
+    cases (mean edge strain, Jacobi -> global, see `SettleSettings.method`): shirt 1.43 -> 1.36 %, hoody 1.51 ->
     1.40 %, T-shirt 1.08 -> 1.02 %, kimono 1.79 -> 1.19 %; since the wrap ends with edge-length restoration
     (`kitsuke.cloth.restore_lengths`), which takes that stretch out too, both settles end at the same strain.
     """

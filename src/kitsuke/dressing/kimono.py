@@ -22,7 +22,7 @@ from .wrap import DressedGarment, WrapParams, wrap
 OBI_WIDTH_M = 0.15
 #: The obi's lower edge below the rig's spine joint (the natural waist), metres.
 OBI_BELOW_WAIST_M = 0.02
-#: WrapParams.hang for a kimono: its sleeves' lower halves hang as bags below the arms (see WrapParams).
+#: The growth's hang (`GrowSettings.hang`) for a kimono: its sleeves' lower halves hang as bags below the arms.
 KIMONO_HANG = 2.0
 #: How far a kimono lies off the skin, metres: it is worn over a hadajuban and a nagajuban (under-kimono), each of
 #: about a millimetre, so its contact offset is 3 mm where a garment worn on the skin has ClothParams' 1 mm. (Also
@@ -45,17 +45,17 @@ def check_kimono(pattern) -> None:  # noqa: ANN001 - a Pattern
 def kimono_params(body, params: WrapParams | None = None, *, hang: float | None = None) -> WrapParams:
     """`params` (default WrapParams()) made right for a kimono: sleeves that hang, the cloth KIMONO_OFFSET_M off
     the body (where `params` keeps ClothParams' default offset) and, on a rigged body, the waist held in the obi
-    band (where `params` holds no band). `hang` sets WrapParams.hang; None keeps a hang that `params` sets and
+    band (where `params` holds no band). `hang` sets the growth's hang; None keeps a hang that `params` sets and
     gives KIMONO_HANG where it sets none (0)."""
     p = params or WrapParams()
     changes: dict = {}
     if p.cloth.contact_offset_m == ClothParams().contact_offset_m:
         changes["cloth"] = dataclasses.replace(p.cloth, contact_offset_m=KIMONO_OFFSET_M)
-    if hang is not None or p.hang == 0.0:
-        changes["hang"] = KIMONO_HANG if hang is None else hang
-    if p.hold_band_m is None and getattr(body, "rig", None) is not None:
-        changes["hold_band_m"] = obi_band(body)
-    return dataclasses.replace(p, **changes)
+    if hang is not None or p.grow.hang == 0.0:
+        changes["grow.hang"] = KIMONO_HANG if hang is None else hang
+    if p.settle.hold_band_m is None and getattr(body, "rig", None) is not None:
+        changes["settle.hold_band_m"] = obi_band(body)
+    return p.changed(changes)
 
 
 def obi_band(body) -> tuple[float, float]:
@@ -89,8 +89,8 @@ def dress_kimono(pattern, body=None, *, params: WrapParams | None = None) -> Dre
     check_kimono(pattern)
     body = default_body() if body is None else body
     p = params or WrapParams()
-    if p.hold_band_m is None:  # obi_band raises for a body without a rig
-        p = dataclasses.replace(p, hold_band_m=obi_band(body))
+    if p.settle.hold_band_m is None:  # obi_band raises for a body without a rig
+        p = p.changed({"settle.hold_band_m": obi_band(body)})
     strokes = carried_strokes(load_packaged_strokes("kimono_default"), default_kimono(), pattern)
     return wrap(body, pattern, strokes, params=kimono_params(body, p))
 

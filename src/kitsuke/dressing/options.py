@@ -4,7 +4,6 @@ with the same options is the same garment."""
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -45,9 +44,11 @@ class DressOptions:
 
         make = WrapParams.strokes_held if self.hold_strokes else WrapParams
         reach = self.stroke_reach * 1e-3 if self.stroke_reach > 0 else None
-        params = make(edge_length_cm=self.edge_length, stroke_reach_m=reach, hang=self.hang or 0.0)
+        params = make(edge_length_cm=self.edge_length).changed(
+            {"tethers.reach_m": reach, "grow.hang": self.hang or 0.0}
+        )
         if self.no_polish:
-            params = dataclasses.replace(params, polish_rounds=0)
+            params = params.changed({"polish.rounds": 0})
         if is_kimono(pattern):
             params = kimono_params(body, params, hang=self.hang)
         return params

@@ -28,17 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..cloth import (
-    BodyCollider,
-    ClothModel,
-    ClothParams,
-    ClothState,
-    collide,
-    folded_faces,
-    relax,
-    restore_lengths,
-    untangle,
-)
+from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, collide, folded_faces
 from ..errors import InputError
 from ..geometry import TriMesh
 from ..geometry.surface import Surface
@@ -48,10 +38,23 @@ from ._drag_field import follow_weights
 from ._place import RESIDUAL_SAMPLES, body_path, lay_along, locate_in_triangles, polyline_distance
 from ._polish_step import PolishSettings, polish_step
 from ._polyline import resample_polyline
-from ._solve import GlobalRelax
+from ._solve import CG_ITERATIONS
+from ._stages import (
+    Closing,
+    Finishing,
+    Settling,
+    StageLog,
+    Untangling,
+    close_stage,
+    finish_stage,
+    run_stage,
+    settle_stage,
+    untangle_stage,
+)
 from .export import GarmentFile, as_garment_file
 from .strokes import Strokes, strokes_on_surface
 from .wrap import offset_as_dressed
+from .wrap_settings import CloseSettings, LengthSettings, SettleSettings
 
 #: Largest distance, metres, from a pin point to the garment vertex it snaps to (as in the drags file).
 PIN_SNAP_M = 0.05
@@ -260,37 +263,41 @@ def rewrap(
     move[reach] = weight[reach, None] * shift[nearest[reach]]
     move[pinned] = 0.0
     move[on_stroke] = shift[on_stroke]
-    state = ClothState.new(model, g.positions + move, pinned=pinned | on_stroke)
-    collide(model, state, collider)
+    state = ClothState.new(model, g.positions + move)
+    collide(model, state.holding(pinned | on_stroke), collider)
     timings["place"] = time.perf_counter() - t1
 
     # 3. Relax with the strokes and pins held, then settle with the pins only.
     t2 = time.perf_counter()
-    solver = GlobalRelax(model, state.pinned, contact_weight=p.contact_weight)
-    for _ in range(p.close_iterations):
-        solver.step(state, collider)
-    state.pinned = pinned | (on_stroke & (not p.release_strokes))
+    log = StageLog("rewrap")
+    close = CloseSettings(
+        iterations=p.close_iterations, tolerance_m=0.0, cg_iterations=CG_ITERATIONS, contact_weight=p.contact_weight
+    )
+    run_stage(log, "closing", close_stage, model, state, collider, Closing(close), pinned=pinned | on_stroke)
+    held = pinned | (on_stroke & (not p.release_strokes))
     # Edge-length restoration (as in the wrap) before the settle and after it. Only after: triangles along the
     # held stroke row folded against it and stayed so (kimono, hem turned up: 3); only before: the settle's
     # gravity sagged the cloth between sparse pins (median move at the chest 5.9 mm instead of < 5).
-    if p.length_sweeps:
-        restore_lengths(model, state, collider, sweeps=p.length_sweeps)
+    lengths = Finishing(
+        LengthSettings(sweeps=p.length_sweeps, chebyshev_rho=None, collide_every=3), close, search_afresh=False
+    )
+    run_stage(log, "restoring lengths", finish_stage, model, state, collider, lengths, pinned=held)
     if p.settle_iterations:
         # The Jacobi settle, not the wrap's global one: with the strokes held, the global settle left a triangle
         # folded against the held stroke row that the untangle cannot open (kimono, hem turned up: 1 vs 0).
-        relax(model, state, collider, iterations=p.settle_iterations)
-    if p.length_sweeps and p.settle_iterations:
-        restore_lengths(model, state, collider, sweeps=p.length_sweeps)
-    if p.untangle_rounds:
-        untangle(model, state, collider, rounds=p.untangle_rounds, iterations=p.untangle_iterations)
-        folded = folded_faces(model, state)
-        if folded.any():
-            # A triangle folded against the held stroke row cannot open while the row holds it (the 1.5 cm kimono,
-            # hem turned up: 2 left folded): let go of the stroke vertices of the folded triangles only, and retry.
-            loose = np.zeros(model.n_vertices, dtype=bool)
-            loose[model.faces[folded].reshape(-1)] = True
-            state.pinned = state.pinned & ~(loose & ~pinned)
-            untangle(model, state, collider, rounds=p.untangle_rounds, iterations=p.untangle_iterations)
+        settling = Settling(SettleSettings(iterations=p.settle_iterations), model.params, p.contact_weight)
+        run_stage(log, "settling", settle_stage, model, state, collider, settling, pinned=held)
+        run_stage(log, "restoring lengths", finish_stage, model, state, collider, lengths, pinned=held)
+    untangling = Untangling(p.untangle_rounds, iterations=p.untangle_iterations)
+    run_stage(log, "untangling", untangle_stage, model, state, collider, untangling, pinned=held)
+    folded = folded_faces(model, state)
+    if p.untangle_rounds and folded.any():
+        # A triangle folded against the held stroke row cannot open while the row holds it (the 1.5 cm kimono,
+        # hem turned up: 2 left folded): let go of the stroke vertices of the folded triangles only, and retry.
+        loose = np.zeros(model.n_vertices, dtype=bool)
+        loose[model.faces[folded].reshape(-1)] = True
+        held = held & ~(loose & ~pinned)
+        run_stage(log, "untangling", untangle_stage, model, state, collider, untangling, pinned=held)
 
     def residual_of(positions: np.ndarray, _refined=None) -> np.ndarray:
         """(S,) metres: each pattern stroke's largest distance (on the garment) from its 3D stroke (the polish here
@@ -307,7 +314,7 @@ def rewrap(
         # and not kept if it takes a stroke farther from its line.
         kept, polished = polish_step(
             model,
-            state,
+            state.holding(held),
             collider,
             PolishSettings(
                 rounds=p.polish_rounds, untangle_rounds=p.untangle_rounds, untangle_iterations=p.untangle_iterations

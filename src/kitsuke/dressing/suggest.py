@@ -270,7 +270,7 @@ def settled_strokes(body, pattern: Pattern, strokes: Strokes, surface: Surface) 
     from ..errors import ComputationError
     from .wrap import WrapParams, wrap
 
-    quick = WrapParams(polish_rounds=0, stroke_reach_m=None)
+    quick = WrapParams().changed({"polish.rounds": 0, "tethers.reach_m": None})
     try:
         g = wrap(body, pattern, strokes, params=quick, report=False, check=False)
     except (ComputationError, InputError):

@@ -58,296 +58,35 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..body.legs import leg_gap
-from ..cloth import (
-    BodyCollider,
-    ClothModel,
-    ClothParams,
-    ClothState,
-    RefinedPolish,
-    Tethers,
-    relax,
-    restore_lengths,
-    untangle,
-)
+from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, RefinedPolish, Tethers
 from ..errors import ComputationError, InputError
 from ..geometry import TriMesh
 from ..metrics import QualityReport, quality_report, strain
 from ..pattern import Pattern, PatternMesh, face_layers, mesh_pattern
 from ._bridge import bridged, spans_legs
-from ._grow import grow
 from ._mend import MendStats, mend_tears
 from ._place import StrokeTrack, place_strokes
-from ._polish_step import PolishSettings, polish_step
+from ._polish_step import polish_step
 from ._refined import pieces_contiguous, remap_track, reorder_state
-from ._solve import GlobalRelax, gravity_settle
+from ._stages import (
+    Closing,
+    Finishing,
+    Growing,
+    Settling,
+    StageLog,
+    Untangling,
+    check_finite,
+    close_stage,
+    finish_stage,
+    grow_stage,
+    run_stage,
+    settle_stage,
+    untangle_stage,
+)
 from ._weld import repair_corners, weld
 from .outcome import on_body_failures, target_misses
 from .strokes import Strokes, resolve_strokes
-
-
-@dataclass(frozen=True)
-class WrapParams:
-    """Options of `wrap`; each with its unit and reason.
-
-    edge_length_cm : target edge length when `wrap` meshes a Pattern itself, cm.
-    lift_m : the transferred stroke triangles are placed this far off the body, metres (just outside the cloth's
-        contact offset, so collision does not fight the placement).
-    rings_per_relax : growth rings between relaxations (more is faster, fewer keeps growth closer to the body).
-    hang : how strongly cloth growing off the body turns down as it grows (`_grow.unfold`); 0 grows straight on (the
-        paper's growth). Without it a kimono's sleeve, grown from its crease along the top of the arm, wraps its lower
-        half round the forearm in bunches, and no settle lets it fall (it touches the arm, and friction holds it). With
-        2 (`kimono.KIMONO_HANG`) it hangs as a bag below the arm: the kimono's mean / max strain 0.68 -> 0.51 % / 71 ->
-        60 % at 1.5 cm edges (0.52 % / 65 % with length_collide_every 4); its max 192 -> 39 % at 2 cm and 135 -> 66 % at
-        2.5 cm, with nothing torn to mend. Not the default: on fitted garments it gains nothing and can cost (shirt 0.86
-        -> 0.84 % mean, hoody 0.87 -> 0.87 %; the T-shirt, whose loose front hangs off the belly, 0.40 -> 0.55 % / 12 ->
-        24 % with a crease down its front; the shirt at 2.5 cm edges 3 -> 7.9 mm deepest inside).
-    skirt_hang : the hang of a garment that goes round both legs (where `bridge_legs` fills the gap) when `hang`
-        is 0: a skirt's flare grown straight on sticks out as a flat disc (a GarmentCode dress: its skirt torn at
-        7x the length after the mend; with 2, 46 % max strain).
-    hang_clearance_m : metres; cloth counts as off the body (turns down as it grows) where both vertices of the
-        edge it grows from are at least this far from the body.
-    grow_iterations : relaxation iterations (no gravity) after each group of rings.
-    close_iterations : most iterations of the closing relaxation after growth (`_solve.GlobalRelax`: a global
-        least-squares solve per iteration, no gravity); it stops early once the largest vertex move falls below
-        `close_tolerance_m`. Its first ~10 steps pull the seams shut (the largest move falls from 5 cm to 3 mm on
-        the shirt); later ones only creep (1 % less strain per step), which the edge-length restoration after the
-        settle does faster: 15 steps and 1200 sweeps beat 40 steps and 300 sweeps on all four shipped cases.
-    close_tolerance_m : metres, see close_iterations.
-    close_cg_iterations : most conjugate-gradient iterations of each close step's contact solve (an inexact
-        solve is enough: each step starts from the last). Mean / max strain of the whole wrap, 40 -> 10: shirt
-        0.84 -> 0.86 % / 30 -> 30 %, hoody 0.82 -> 0.87 % / 24 -> 27 %, T-shirt 0.41 -> 0.40 % / 13 -> 12 %,
-        kimono 0.68 -> 0.68 % / 64 -> 71 %; the shirt's close 0.45 -> 0.20 s. (20 left one shirt vertex 3.4 mm
-        inside the body: the result is chaotic in it.)
-    stroke_hold : weight (relative to one triangle edge) pulling the stroke vertices towards their transferred
-        positions during the close; 0 lets the garment find its own rest around the strokes (measured on the
-        shirt: any hold >= 0.01 raises the mean strain, the strokes ask for more than the pattern can give).
-    contact_weight : weight (relative to one triangle edge) of the body contacts inside the closing solve: each
-        vertex touching the body is held on the plane of its contact (normal direction only, so cloth slides;
-        released where the solve pulls it off). 0 applies collision only after each solve, which fights the
-        solve where it pulls cloth into the body (measured on the kimono: strain 2.5 % mean / 439 % max at 0,
-        1.7 % / 84 % at 20).
-    settle : "jacobi" (default): `settle_iterations` of the paper's relaxation (`kitsuke.cloth.relax`) with
-        gravity, friction and collision; "global": `settle_iterations` (30 is enough) global steps
-        (`_solve.gravity_settle`) with gravity `settle_gravity_m` per step and static friction `stick_weight`.
-        The global settle does not stretch hanging cloth (mean strain, jacobi -> global, before the finish and
-        the length restoration: shirt 2.6 -> 1.8 %; after them both end at 0.8 %), costs ~0.1-0.2 s more,
-        and one of the drag scenarios of tests/dressing/test_drag.py on the kimono settled that way fails (the
-        lift, on the 1.5 cm kimono; on the 3 cm one before: a folded triangle the drag's untangle did not open);
-        so it is not the default.
-    settle_iterations : iterations (jacobi) or steps (global) of the settle.
-    settle_gravity_m : global settle: metres a free vertex falls per step.
-    stick_weight : global settle: static friction (relative to one triangle edge); cloth touching the body when
-        the settle starts is held along the body, so gravity does not slide the garment down the frictionless
-        contact planes.
-    finish_iterations : iterations of the global relaxation (with contacts, without gravity, friction or stroke
-        holds, the settle's pins kept) after the settle. The Jacobi settle lets gravity stretch cloth that rests
-        on the body (shirt: contact edges 2.1 % -> 4.1 % stretch), far more than real fabric stretches under its
-        own weight; these steps take that back and keep the drape (shirt mean strain 2.13 -> 1.43 %, hoody 2.08
-        -> 1.41 %). Off by default since the length sweeps take it back as well (measured with the sweeps
-        over-relaxed): mean / max strain of the whole wrap at 10 -> 0 steps: shirt 0.75 -> 0.84 % / 28 -> 30 %,
-        hoody 0.84 -> 0.82 % / 29 -> 24 %, T-shirt 0.39 -> 0.41 % / 18 -> 13 %, kimono 0.64 -> 0.68 % / 63 ->
-        64 %; the shirt's wrap ~0.25 s faster (bench_wrap median 1.81-1.86 -> 1.58-1.63 s).
-    length_sweeps : Gauss-Seidel sweeps of `kitsuke.cloth.restore_lengths` after the settle (with collision, the
-        settle's pins kept, a hold band let go): the least-squares steps take out strain spread over the garment
-        but slowly; edge projection takes out the local rest. Mean strain without -> with (15 close steps, 1200
-        sweeps): shirt 1.43 -> 0.81 %, hoody 1.51 -> 0.94 %, T-shirt 1.08 -> 0.46 %, kimono 1.79 -> 0.89 %.
-    length_chebyshev_rho : the length sweeps' Chebyshev acceleration (`restore_lengths`' chebyshev_rho), or
-        None. Measured 2026-11-25 on the shipped cases, mean / max strain, 1200 sweeps over-relaxed at 1.5 (the
-        default before) -> 400 sweeps accelerated at 0.99: shirt 0.89 -> 0.82 % / 31 -> 30 %, hoody 0.84 -> 0.83 %
-        / 31 -> 25 %, T-shirt 0.40 -> 0.38 % / 12 -> 12 %, kimono 0.55 -> 0.52 % / 51 -> 41 %, in 40 % of the
-        time (the shirt's finish 455 -> 192 ms). rho 0.995 overshoots (T-shirt max 23 %); 300 sweeps at 0.99
-        leave more (kimono max 63 %).
-    length_over_relaxation : omega of the length sweeps (`restore_lengths`' over_relaxation; 1: plain
-        Gauss-Seidel). Before the acceleration, mean / max strain at 1200 sweeps, 1 -> 1.5: shirt 0.87 -> 0.75 %
-        / 30 -> 28 %, T-shirt 0.46 -> 0.39 % / 26 -> 18 %. With it, leave it at 1: both at once overshoot.
-    length_collide_every : a collision update after this many length sweeps. 4 rather than restore_lengths' 3:
-        `bench_wrap.py --repeat 7` on the shirt, alternately, 1.28 / 1.25 s median against 1.39 / 1.58 s (a noisy
-        hour), the deepest vertex 0.9 mm out of the body instead of 1.5 mm; mean / max strain shirt 0.89 % / 31 %,
-        hoody 0.84 % / 31 %, T-shirt 0.40 % / 12 %, kimono 0.52 % / 65 %, nothing inside or folded. 6 left a shirt
-        vertex 2.4 mm inside the body.
-    stroke_reach_m : metres, or None. The length restoration and the last untangle keep every pattern stroke
-        within this distance of its body stroke (`kitsuke.cloth.Tethers`: a one-sided pull on the stroke's 32
-        samples, only where they have settled farther). The settled garment rests where gravity and its ease put
-        it, 15-22 mm from the shipped strokes (a loose shirt's front hangs off the belly, a hood behind the
-        head); a user who drew a line meant it there. Measured with 8 mm on the shipped cases (residual and mean
-        strain without -> with, the last untangle at bend 0.3): shirt 20.6 -> 8.6 mm, 0.81 -> 0.94 %; hoody
-        22.2 -> 8.4 mm, 0.94 -> 0.98 %; T-shirt 14.9 -> 8.2 mm, 0.46 -> 0.55 %; kimono 19.6 -> 8.8 mm, 0.89 ->
-        0.95 %. None: no pull.
-    tether_slack_m : metres. A stroke whose cloth the settle left farther than this from its body stroke is not
-        tethered (`stroke_reach_m`): the pattern cannot lie there without stretching, and pulling it back tears the
-        cloth; its residual is reported (`DressedGarment.loose_strokes`). The shipped cases settle 15-22 mm away.
-    tether_strain : a strain. Where the finish and polish with the stroke tethers leave an edge strained more than
-        this, they run again without them, and the strokes are let go (`loose_strokes`) if that halves the max
-        strain and brings it within twice MAX_STRAIN_TARGET: the strokes ask for what the pattern cannot give.
-    untangle_bend : hinge stiffness of the last untangle (`kitsuke.cloth.untangle`'s bend_stiffness; the one
-        after the close keeps its 0.3). The folds left after the length restoration are where the sweeps laid
-        spare cloth flat; a stiff hinge opens them into strained cloth. Mean / max strain at 0.3 -> 0.1: shirt
-        0.94 -> 0.87 % / 31 -> 31 %, hoody 0.98 -> 0.87 % / 31 -> 29 %, T-shirt 0.55 -> 0.46 % / 30 -> 26 %,
-        kimono 0.95 -> 0.64 % / 82 -> 65 %; at 0.02 two kimono triangles stay folded.
-    tear_strain : fraction, or None. After the close, cloth round edges stretched more than this (1.0: twice
-        their rest length) is grown again from the closed cloth around it and closed again (`_mend.mend_tears`):
-        where growth wrapped it round the wrong side of a limb, the limb goes through it and the close cannot pull
-        it back. Max strain of the finished wrap without -> with: GarmentCode's shirt at 1 cm 774 -> 40 %, at
-        2 cm 433 -> 37 %; the kimono's sleeves at 2-2.5 cm stay torn (177 -> 301 %, 276 -> 130 %: regrown, they
-        catch on the forearm again). The shipped 1.5 cm cases never reach it (worst after the close: 83 %), so
-        they are unchanged. None: no mending.
-    mend_rounds : most mending rounds (0: none).
-    untangle_rounds : most rounds of `kitsuke.cloth.untangle` after the close and at the end (0: none). Measured
-        on GarmentCode's hoody on mean_all: 7 folded triangles at the neckline after the finish, 0 after one
-        round, the rest of the garment untouched; the kimono: 16 -> 0 (one of them inside the obi band, which
-        only the untangle after the close can reach).
-    polish_rounds : rounds of `kitsuke.cloth.polish` at the end (0: none), each of up to `polish_iterations` L-BFGS
-        iterations; its result is kept only if better (see the module docstring, step 7, and `_polish_step`).
-        Measured 2026-11-25 (with everything below): mean / max strain GarmentCode's shirt 0.84 / 28.7 -> 0.77 /
-        4.6 %, hoody 0.83 / 25.3 -> 0.37 / 4.5 %, the FreeSewing T-shirt 0.38 / 11.6 -> 0.27 / 4.5 %; the kimono's
-        is not kept (its fronts pushed through each other).
-    polish_refine_levels : where the polish leaves triangles folded (at most `polish_refine_max_folds` of them), up
-        to this many adaptive sqrt(3) levels of the cloth within `polish_refine_rings` rings of the folds, each
-        polished again with up to `polish_refine_iterations` L-BFGS iterations per round (`polish_refined`): the
-        crease becomes a wrinkle of finer triangles instead of being pressed flat by the untangle. The garment then
-        has more faces than its pattern mesh (the OBJ's `vt` still give every corner's pattern position). Measured
-        2026-11-25 on GarmentCode's hoody (3 mm offset): 9 folded triangles after the polish, 0 after 3 levels, max
-        strain 4.5 % (32 % polished and untangled); 0: no refinement.
-    polish_strain_limit, polish_limit_sweeps : after each polish, up to this many Gauss-Seidel sweeps (400 between
-        refinement levels) pull every edge strained more than the limit back to it, and leave the others alone
-        (`restore_lengths` with a band), the stroke tethers and collision kept. The polish spreads strain but its
-        barrier is soft (a stiffer one stalls L-BFGS); the limit takes the few edges it left over 5 % under without
-        the equal-length sweeps' flattening of its buckles. Over 1 nm changes of the body the shirt ended at
-        4.66-4.68 % with 1000 sweeps (4.58-4.86 % with 1500 and a barrier a third as stiff). 0 sweeps: none.
-    polish_passes : most polish passes; a later one runs only while the max strain is over 5 %, from the better
-        cloth the last one kept.
-    bridge_legs : fill the gap between the legs (`kitsuke.body.legs`) for the growth, the close and the mend, so
-        cloth grown over the hips drapes round both legs; None (default): when the garment has an opening below
-        the crotch that goes round both legs by its placement (`_bridge.spans_legs`: a skirt's hem, not a trouser
-        leg's); True / False: always / never.
-    release_strokes : unpin the stroke triangles for the settle (the paper lets the garment settle freely);
-        False keeps them where the strokes put them.
-    hold_band_m : (low, high) heights in metres, or None: garment vertices in this band are pinned for the settle
-        (a kimono's waist, held by the obi), where they are within `hold_reach_m` of the body.
-    hold_reach_m : metres; the hold band holds only cloth this close to the body and, on a rigged body, over the
-        torso (what a tied obi presses on; the kimono's overlapping fronts and looser folds lie centimetres out).
-        See `_band_held`.
-    cloth : ClothParams of the Jacobi relaxation (growth, without gravity; the default settle, with it), of the
-        untangle and of the returned model (a later drag). Strain limiting is off by default: where the grown
-        garment is still strained at seams, it would drag the whole garment towards its supports in one
-        iteration (measured on the shirt: the shirt ends up a scarf).
-    """
-
-    edge_length_cm: float = 1.5
-    lift_m: float = 0.004
-    rings_per_relax: int = 1
-    hang: float = 0.0
-    skirt_hang: float = 2.0
-    hang_clearance_m: float = 0.03
-    grow_iterations: int = 2
-    close_iterations: int = 15
-    close_tolerance_m: float = 2e-4
-    close_cg_iterations: int = 10
-    stroke_hold: float = 0.01
-    contact_weight: float = 20.0
-    settle: str = "jacobi"
-    settle_iterations: int = 60
-    settle_gravity_m: float = 0.002
-    stick_weight: float = 20.0
-    finish_iterations: int = 0
-    length_sweeps: int = 400
-    length_chebyshev_rho: float | None = 0.99
-    length_over_relaxation: float = 1.0
-    length_collide_every: int = 4
-    stroke_reach_m: float | None = 0.008
-    untangle_bend: float = 0.1
-    tether_slack_m: float = 0.03
-    tether_strain: float = 0.15
-    tear_strain: float | None = 1.0
-    mend_rounds: int = 3
-    untangle_rounds: int = 10
-    polish_rounds: int = 8
-    polish_iterations: int = 40
-    polish_refine_levels: int = 5
-    polish_refine_rings: int = 2
-    polish_refine_iterations: int = 80
-    polish_refine_max_folds: int = 60
-    polish_passes: int = 2
-    polish_strain_limit: float = 0.045
-    polish_limit_sweeps: int = 1000
-    release_strokes: bool = True
-    bridge_legs: bool | None = None
-    hold_band_m: tuple[float, float] | None = None
-    hold_reach_m: float = 0.05
-    cloth: ClothParams = field(default_factory=lambda: ClothParams(max_stretch=None))
-
-    @classmethod
-    def strokes_held(cls, **changes) -> WrapParams:
-        """Parameters that make the strokes constraints rather than a starting placement: held firmly in the close
-        and kept where they lie through the settle, so the garment hangs from them. Strokes are then met within
-        millimetres, and where they ask for more than the pattern gives, the cloth stretches instead (measured on
-        the shipped strokes against the default's tethers: residual shirt 7.6 mm vs 8.6 mm, T-shirt 6.5 vs 8.2 mm;
-        mean strain shirt 1.42 vs 0.94 %, T-shirt 0.77 vs 0.55 %). `changes` as for WrapParams."""
-        return cls(**{"stroke_hold": 1.0, "release_strokes": False, **changes})
-
-    def __post_init__(self) -> None:
-        for name in ("rings_per_relax", "close_cg_iterations", "length_collide_every"):
-            if getattr(self, name) < 1:
-                raise InputError(f"wrap parameter {name} must be >= 1")
-        for name in (
-            "grow_iterations",
-            "close_iterations",
-            "settle_iterations",
-            "finish_iterations",
-            "length_sweeps",
-            "mend_rounds",
-            "untangle_rounds",
-            "polish_rounds",
-            "polish_refine_levels",
-            "polish_refine_rings",
-            "polish_refine_max_folds",
-            "polish_limit_sweeps",
-            "polish_passes",
-        ):
-            if getattr(self, name) < 0:
-                raise InputError(f"wrap parameter {name} must be >= 0")
-        if not (
-            self.edge_length_cm > 0
-            and self.tether_slack_m > 0
-            and self.lift_m >= 0
-            and self.close_tolerance_m >= 0
-            and self.stroke_hold >= 0
-            and self.contact_weight >= 0
-        ):
-            raise InputError(
-                "wrap parameters edge_length_cm > 0, tether_slack_m > 0, lift_m >= 0, close_tolerance_m >= 0, "
-                "stroke_hold >= 0, "
-                "contact_weight >= 0 required"
-            )
-        if self.settle not in ("jacobi", "global"):
-            raise InputError(f'wrap parameter settle must be "jacobi" or "global", got {self.settle!r}')
-        if not (self.settle_gravity_m >= 0 and self.stick_weight >= 0):
-            raise InputError("wrap parameters settle_gravity_m >= 0 and stick_weight >= 0 required")
-        if self.hold_band_m is not None and not (
-            len(self.hold_band_m) == 2 and self.hold_band_m[0] < self.hold_band_m[1]
-        ):
-            raise InputError("hold_band_m must be (low, high) with low < high, metres")
-        if (
-            not (np.isfinite(self.hang) and self.hang >= 0 and np.isfinite(self.skirt_hang) and self.skirt_hang >= 0)
-            or not self.hang_clearance_m >= 0
-        ):
-            raise InputError("wrap parameters hang, skirt_hang >= 0 (finite) and hang_clearance_m >= 0 required")
-        if self.polish_iterations < 1 or self.polish_refine_iterations < 1:
-            raise InputError("wrap parameters polish_iterations and polish_refine_iterations must be >= 1")
-        if not 0.0 <= self.polish_strain_limit < 1.0:
-            raise InputError("wrap parameter polish_strain_limit must be a strain in [0, 1)")
-        if not self.untangle_bend >= 0:
-            raise InputError("wrap parameter untangle_bend must be >= 0")
-        if self.stroke_reach_m is not None and not self.stroke_reach_m > 0:
-            raise InputError("wrap parameter stroke_reach_m must be > 0 (metres) or None")
-        if not 1.0 <= self.length_over_relaxation < 2.0:
-            raise InputError("wrap parameter length_over_relaxation must be in [1, 2)")
-        if self.length_chebyshev_rho is not None and not 0.0 < self.length_chebyshev_rho < 1.0:
-            raise InputError("wrap parameter length_chebyshev_rho must be in (0, 1) or None")
-        if self.tear_strain is not None and not self.tear_strain > 0:
-            raise InputError("wrap parameter tear_strain must be > 0 (a fraction: 1.0 = twice the rest length) or None")
-        if not self.hold_reach_m > 0:
-            raise InputError("wrap parameter hold_reach_m must be > 0 (metres)")
+from .wrap_settings import WrapParams
 
 
 @dataclass
@@ -552,38 +291,30 @@ def wrap(
 
     welded = weld(pm)
     shaping = collider  # growth, close and mend run against the body with its leg gap filled, for a skirt
-    hang = p.hang
-    gap = leg_gap(mesh) if p.bridge_legs is not False else None
-    if gap is not None and (p.bridge_legs or spans_legs(pm, welded, gap.crotch_y)):
+    hang = p.grow.hang
+    gap = leg_gap(mesh) if p.grow.bridge_legs is not False else None
+    if gap is not None and (p.grow.bridge_legs or spans_legs(pm, welded, gap.crotch_y)):
         shaping = bridged(collider, gap)
-        hang = hang or p.skirt_hang
+        hang = hang or p.grow.skirt_hang
     placements = None if pattern is None else {pc.name: pc.placement for pc in pattern.pieces if pc.placement}
-    placement = place_strokes(pm, welded, strokes, surface, collider, lift_m=p.lift_m, placements=placements)
+    placement = place_strokes(pm, welded, strokes, surface, collider, lift_m=p.grow.lift_m, placements=placements)
     grow_params = dataclasses.replace(p.cloth, gravity_step_m=0.0)
     layer = face_layers(pm.layers, pm.piece_names, welded.piece_faces, welded.rest_corners * 100.0)
     model = ClothModel.from_corners(
         welded.faces, welded.rest_corners, n_vertices=welded.n_vertices, params=grow_params, face_layer=layer
     )
-    state = ClothState.new(model, placement.positions, pinned=placement.placed.copy(), face_active=placement.seed_faces)
-    seed_pins = placement.placed.copy()
-    t3 = time.perf_counter()
-    timings["place"] = t3 - t2
-    say("growing the cloth")
+    state = ClothState.new(model, placement.positions, face_active=placement.seed_faces)
+    seed_pins = placement.placed.copy()  # the stroke triangles' vertices, held while the garment grows
+    free = np.zeros(model.n_vertices, dtype=bool)
+    timings["place"] = time.perf_counter() - t2
+    log = StageLog("wrap", say, timings)
 
-    def grow_from(placed: np.ndarray) -> int:
-        """Grow the inactive triangles from the placed vertices; also the mend's regrowth."""
-        return grow(
-            model,
-            state,
-            placed,
-            lambda _ring: relax(model, state, shaping, iterations=p.grow_iterations),
-            rings_per_relax=p.rings_per_relax,
-            hang=hang,
-            hang_clearance_m=p.hang_clearance_m,
-        )
-
-    # The seed faces' vertices are placed; faces whose three vertices are placed (next to a seed) join at once.
-    rings = grow_from(placement.placed.copy())
+    # Step 2: the seed faces' vertices are placed; faces whose three vertices are placed join at once.
+    growing = Growing(p.grow, hang, placement.placed.copy())
+    rings = run_stage(
+        log, "growing the cloth", grow_stage, model, state, shaping, growing, pinned=seed_pins, timing="grow"
+    )
+    rings = rings["rings"]
     if not state.face_active.all():
         missing = np.flatnonzero(~state.face_active)
         piece_of = np.searchsorted(welded.piece_faces[:, 1], missing, side="right")
@@ -592,244 +323,119 @@ def wrap(
             f"no stroke reaches piece(s) {', '.join(names)}: draw a stroke on them or sew them to a piece that has one",
             strokes.source or None,
         )
-    _finite(state, "grow")
-    t4 = time.perf_counter()
-    timings["grow"] = t4 - t3
-    say("closing the seams")
 
-    # Close: the global relaxation (see _solve), stroke pins released so that collision reaches the stroke
-    # triangles too; they are only held softly towards where the strokes put them (`stroke_hold`).
-    state.pinned = np.zeros(model.n_vertices, dtype=bool)
+    # Step 3, the close: stroke pins released so that collision reaches the stroke triangles too; they are only held
+    # softly towards where the strokes put them (`close.stroke_hold`). The mend regrows torn cloth and closes again.
     mended = MendStats()
-    if p.close_iterations:
-        targets = state.positions.copy()
+    closing = Closing(p.close, held=seed_pins, targets=state.positions.copy())
+    if p.close.iterations:
+        run_stage(log, "closing the seams", close_stage, model, state, shaping, closing, pinned=free, timing="close")
+        if p.close.tear_strain is not None and p.close.mend_rounds:
 
-        # A fresh solver for every close: after the mend regrows cloth, contacts the last close had released must
-        # hold again (measured on the kimono at 2.5 cm: one solver kept edges 238 % long after the mend, fresh
-        # ones 116 %).
-        def close() -> None:
-            solver = GlobalRelax(
-                model,
-                state.pinned,
-                held=seed_pins,
-                targets=targets,
-                hold_weight=p.stroke_hold,
-                contact_weight=p.contact_weight,
-                cg_iterations=p.close_cg_iterations,
+            def mend(model: ClothModel, state: ClothState, collider: BodyCollider, config: Closing) -> dict:
+                stats = mend_tears(
+                    model,
+                    state,
+                    placement.seed_faces,
+                    lambda placed: grow_stage(model, state, collider, dataclasses.replace(growing, placed=placed)),
+                    lambda: close_stage(model, state, collider, config),
+                    tear_strain=p.close.tear_strain,
+                    rounds=p.close.mend_rounds,
+                )
+                return dataclasses.asdict(stats)
+
+            mended = MendStats(
+                **run_stage(log, "mending tears", mend, model, state, shaping, closing, pinned=free, timing="close")
             )
-            for _ in range(p.close_iterations):
-                if solver.step(state, shaping) < p.close_tolerance_m:
-                    break
+    # Before the hold band is pinned: a fold inside the band could not open later.
+    run_stage(
+        log,
+        "untangling after the close",
+        untangle_stage,
+        model,
+        state,
+        shaping,
+        Untangling(p.untangle.rounds),
+        pinned=free,
+        timing="close",
+    )
 
-        close()
-        if p.tear_strain is not None and p.mend_rounds:
-            mended = mend_tears(
-                model,
-                state,
-                placement.seed_faces,
-                grow_from,
-                close,
-                tear_strain=p.tear_strain,
-                rounds=p.mend_rounds,
-            )
-    if p.untangle_rounds:  # before the hold band is pinned: a fold inside the band could not open later
-        untangle(model, state, shaping, rounds=p.untangle_rounds)
-    _finite(state, "close")
-    t5 = time.perf_counter()
-    timings["close"] = t5 - t4
-    say("settling")
-
+    # Step 4: gravity, the strokes let go (or held) and a hold band pinned.
     settle = model.with_params(p.cloth)
-    pins = np.zeros(model.n_vertices, dtype=bool) if p.release_strokes else seed_pins.copy()
+    pins = free.copy() if p.settle.release_strokes else seed_pins.copy()
     band = np.zeros(model.n_vertices, dtype=bool)
-    if p.hold_band_m is not None:
-        band = _band_held(body, mesh, state, p.hold_band_m, p.hold_reach_m) & ~pins
+    if p.settle.hold_band_m is not None:
+        band = _band_held(body, mesh, state, p.settle.hold_band_m, p.settle.hold_reach_m) & ~pins
         pins |= band
-    state.pinned = pins
-    if p.settle_iterations and p.settle == "jacobi":
-        relax(settle, state, shaping, iterations=p.settle_iterations)
-    elif p.settle_iterations:
-        gravity_settle(
-            model,
-            state,
-            collider,
-            pins,
-            iterations=p.settle_iterations,
-            gravity_m=p.settle_gravity_m,
-            stick_weight=p.stick_weight,
-            contact_weight=p.contact_weight,
-        )
-    _finite(state, "settle")
-    t_settled = time.perf_counter()
-    timings["settle"] = t_settled - t5
-    say("restoring lengths and polishing")
-    # The band holds the cloth up against gravity; the finish and the length restoration have none, so they let
-    # it go: pinned where the close left it, the kimono's back under the obi kept 5-20 % strain (mean strain
-    # 1.22 % held, 0.95 % let go).
+    settle_collider = shaping if p.settle.method == "jacobi" else collider
+    settling = Settling(p.settle, p.cloth, p.close.contact_weight)
+    run_stage(log, "settling", settle_stage, model, state, settle_collider, settling, pinned=pins, timing="settle")
+
+    # Steps 5-7. The band holds the cloth up against gravity; the finish and the length restoration have none, so
+    # they let it go (pinned where the close left it, the kimono's back under the obi kept 5-20 % strain).
     unheld = pins & ~band
     tethers = None
     # A stroke whose cloth settled far from it is not pulled back: where the pattern cannot lie along the stroke
-    # without stretching, the pull tears it (a crop top on suggested strokes that slid 8 cm in the close: 44 ->
-    # 249 % max strain with its tethers, 19 % without). Its residual is reported instead.
+    # without stretching, the pull tears it. Its residual is reported instead.
     settled = np.array([tr.residual_m(state.positions, model.faces) for tr in placement.tracks])
-    loose = settled > p.tether_slack_m
-    if p.stroke_reach_m is not None and not loose.all():
-        tethers = Tethers.from_polylines(
-            [(tr.faces, tr.bary, tr.body_path) for tr, far in zip(placement.tracks, loose, strict=True) if not far],
-            model.faces,
-            p.stroke_reach_m,
+    loose = settled > p.tethers.slack_m
+    if p.tethers.reach_m is not None and not loose.all():
+        tethers = _tethers(placement.tracks, loose, model.faces, p.tethers.reach_m)
+
+    def finish_and_polish(state: ClothState, tethers: Tethers | None, loose: np.ndarray) -> _Finished:
+        """Steps 5-7 from the settled `state`."""
+        finishing = Finishing(p.lengths, p.close, tethers)
+        run_stage(
+            log, "restoring lengths", finish_stage, settle, state, collider, finishing, pinned=unheld, timing="finish"
         )
-
-    def finish_and_polish(state: ClothState, tethers: Tethers | None, loose: np.ndarray) -> tuple:
-        """Steps 5-7 from the settled `state`: (state, out_model, piece_faces, corner_uv, tracks, polished)."""
-        t_settled = time.perf_counter()
-        if p.finish_iterations:
-            finish = GlobalRelax(model, unheld, contact_weight=p.contact_weight)
-            for _ in range(p.finish_iterations):
-                if finish.step(state, collider) < p.close_tolerance_m:
-                    break
-        if p.length_sweeps:
-            state.pinned = unheld
-            # The projection moves vertices along edges, across the body's surfaces where arm and torso meet: search
-            # every vertex's nearest point afresh first (`Contacts.forget`; measured on the shirt without it: one
-            # vertex left 2.4 mm inside the torso, tracked to the arm).
-            state.contacts.forget()
-            restore_lengths(
-                settle,
-                state,
-                collider,
-                sweeps=p.length_sweeps,
-                tethers=tethers,
-                over_relaxation=p.length_over_relaxation,
-                chebyshev_rho=p.length_chebyshev_rho,
-                collide_every=p.length_collide_every,
-            )
-            state.pinned = pins
-        _finite(state, "length restoration")
-        t_finished = time.perf_counter()
-        timings["finish"] = t_finished - t_settled
-        if p.untangle_rounds:
-            # Without gravity, like the length restoration: the band is let go here too (a fold the sweeps left in it,
-            # where the kimono's layers lie pressed on each other, could not open otherwise).
-            state.pinned = unheld
-            untangle(settle, state, collider, rounds=p.untangle_rounds, bend_stiffness=p.untangle_bend, tethers=tethers)
-            state.pinned = pins
-        t_untangled = time.perf_counter()
-        timings["untangle"] = t_untangled - t_finished
-
-        polished = False
-        out_model, piece_faces, corner_uv, tracks = settle, welded.piece_faces, welded.rest_corners, placement.tracks
-
-        # The stroke samples of the garment as it is (out_model, tracks: refined by a kept polish), or of the refined
-        # polish rp made of it (its samples moved onto its new faces: between their old corners they lie off the
-        # refined surface; the kimono's sleeve crease 12.0 mm from its stroke that way where it measured 8.7 mm).
-        refined_tracks: dict[int, tuple] = {}  # id(rp) -> (its PieceOrdered, the tracks on it): made once, used twice
-
-        def on_refined(rp: RefinedPolish) -> tuple:
-            if id(rp) not in refined_tracks:
-                ordered = pieces_contiguous(rp, piece_faces)
-                refined_tracks.clear()
-                refined_tracks[id(rp)] = (ordered, [remap_track(tr, corner_uv, piece_faces, ordered) for tr in tracks])
-            return refined_tracks[id(rp)]
-
-        def residual_of(positions: np.ndarray, rp: RefinedPolish | None = None) -> np.ndarray:
-            if rp is None or not rp.levels:
-                return np.array([tr.residual_m(positions, out_model.faces) for tr in tracks])
-            ordered, moved = on_refined(rp)
-            return np.array([tr.residual_m(positions, ordered.model.faces) for tr in moved])
-
-        settings = PolishSettings(
-            rounds=p.polish_rounds,
-            iterations=p.polish_iterations,
-            levels=p.polish_refine_levels,
-            rings=p.polish_refine_rings,
-            refine_iterations=p.polish_refine_iterations,
-            max_folds=p.polish_refine_max_folds,
-            strain_limit=p.polish_strain_limit,
-            limit_sweeps=p.polish_limit_sweeps,
-            untangle_rounds=p.untangle_rounds,
-            untangle_bend=p.untangle_bend,
+        # Without gravity, like the length restoration: the band is let go here too (a fold the sweeps left in it,
+        # where the kimono's layers lie pressed on each other, could not open otherwise).
+        untangling = Untangling(p.untangle.rounds, p.untangle.bend, tethers=tethers)
+        run_stage(
+            log, "untangling", untangle_stage, settle, state, collider, untangling, pinned=unheld, timing="untangle"
         )
-        passes = 0
-        level = pending = None
-        while p.polish_rounds and passes < p.polish_passes:
-            # A later pass only while the max strain is still over the target: it starts from the better cloth and
-            # takes another path to the buckles (chaotic: GarmentCode's shirt at 1.45-1.6 cm edges ends at 4.6-28 %
-            # after one pass).
-            if passes and strain(state.positions, out_model.edges, out_model.rest_lengths).max <= MAX_STRAIN_TARGET:
-                break
-            passes += 1
-            extra = np.zeros(out_model.n_vertices - len(pins), dtype=bool)
-            state.pinned = np.concatenate([unheld, extra])
-            kept, rp = polish_step(
-                out_model,
-                state,
-                collider,
-                settings,
-                tethers=tethers,
-                corner_data={"uv": corner_uv},
-                residual_of=residual_of,
-                level=level,
-                pending=pending,
-            )
-            state.pinned = np.concatenate([pins, extra])
-            if not kept:
-                break
-            polished = True
-            state = rp.state
-            state.pinned = np.concatenate([pins, np.zeros(rp.model.n_vertices - len(pins), dtype=bool)])
-            if rp.levels:
-                ordered, tracks = on_refined(rp)
-                state = reorder_state(state, ordered)
-                level, pending = ordered.level, ordered.pending
-                out_model, piece_faces, corner_uv = ordered.model, ordered.piece_faces, ordered.corner_uv
-                if tethers is not None:  # a later pass holds the strokes on the refined faces
-                    tethers = Tethers.from_polylines(
-                        [(tr.faces, tr.bary, tr.body_path) for tr, far in zip(tracks, loose, strict=True) if not far],
-                        out_model.faces,
-                        p.stroke_reach_m,
-                    )
-        _finite(state, "polish")
-        timings["polish"] = time.perf_counter() - t_untangled
-        return state, out_model, piece_faces, corner_uv, tracks, polished
+        log.say("polishing")
+        t_polish = time.perf_counter()
+        done = _polish_passes(settle, state, collider, p, welded, placement.tracks, tethers, loose, unheld, pins)
+        check_finite(done.state, "wrap: polish")
+        timings["polish"] = timings.get("polish", 0.0) + time.perf_counter() - t_polish
+        return done
 
     settled_state = state.copy() if tethers is not None else None
-    state, out_model, piece_faces, corner_uv, tracks, polished = finish_and_polish(state, tethers, loose)
-    held = strain(state.positions, out_model.edges, out_model.rest_lengths).max
-    if settled_state is not None and held > p.tether_strain:
+    done = finish_and_polish(state, tethers, loose)
+    held = strain(done.state.positions, done.model.edges, done.model.rest_lengths).max
+    if settled_state is not None and held > p.tethers.strain:
         # Strokes the cloth cannot lie along without stretching (a shirt's strokes drawn 2 cm below where its
         # shoulders can go: 46 % max strain held there, 4.6 % let go): the same steps without their tethers, kept
         # when they halve the max strain and end within twice its target; the strokes are then reported loose.
-        spent = {k: timings[k] for k in ("finish", "untangle", "polish")}
-        free = finish_and_polish(settled_state, None, np.ones_like(loose))
-        loose_max = strain(free[0].positions, free[1].edges, free[1].rest_lengths).max
+        free_done = finish_and_polish(settled_state, None, np.ones_like(loose))
+        loose_max = strain(free_done.state.positions, free_done.model.edges, free_done.model.rest_lengths).max
         if loose_max < 0.5 * held and loose_max <= 2 * MAX_STRAIN_TARGET:
-            (state, out_model, piece_faces, corner_uv, tracks, polished), loose = free, np.ones_like(loose)
-        for k, v in spent.items():
-            timings[k] += v
+            done, loose = free_done, np.ones_like(loose)
     t6 = time.perf_counter()
     timings["wrap"] = t6 - t0
 
+    state, out_model, tracks = done.state, done.model, done.tracks
     residual = np.array([tr.residual_m(state.positions, out_model.faces) for tr in tracks])
     ratio = np.array([tr.body_length_m / tr.pattern_length_m for tr in placement.tracks])
     result = DressedGarment(
         name=pm.name,
         piece_names=list(pm.piece_names),
-        piece_faces=piece_faces,
+        piece_faces=done.piece_faces,
         positions=state.positions,
         faces=out_model.faces,
-        corner_uv=corner_uv,
+        corner_uv=done.corner_uv,
         pattern_vertex=welded.vertex_of,
         pattern_mesh=pm,
         model=out_model,
-        pinned=state.pinned,
+        pinned=np.concatenate([pins, np.zeros(out_model.n_vertices - len(pins), dtype=bool)]),
         stroke_ids=[tr.id for tr in placement.tracks],
         stroke_residual_m=residual,
         stroke_length_ratio=ratio,
         tracks=tracks,
         loose_strokes=[tr.id for tr, far in zip(placement.tracks, loose, strict=True) if far],
         rings=rings,
-        polished=polished,
+        polished=done.polished,
         mend=mended,
         timings=timings,
     )
@@ -851,8 +457,91 @@ def wrap(
     return result
 
 
-def _finite(state: ClothState, stage: str) -> None:
-    """Raise ComputationError naming the wrap stage after which a position is no longer finite."""
-    if not np.isfinite(state.positions).all():
-        n = int((~np.isfinite(state.positions).all(axis=1)).sum())
-        raise ComputationError(f"wrap: {stage}", f"{n} cloth positions became non-finite")
+def _tethers(tracks: list[StrokeTrack], loose: np.ndarray, faces: np.ndarray, reach_m: float) -> Tethers:
+    """The one-sided pulls keeping each stroke not `loose` within `reach_m` of its body stroke."""
+    return Tethers.from_polylines(
+        [(tr.faces, tr.bary, tr.body_path) for tr, far in zip(tracks, loose, strict=True) if not far], faces, reach_m
+    )
+
+
+@dataclass
+class _Finished:
+    """The garment after steps 5-7: its state and model (refined where the polish folded), the pieces' face ranges
+    and corner uv of that model, the stroke tracks on it, and whether a polish was kept."""
+
+    state: ClothState
+    model: ClothModel
+    piece_faces: np.ndarray
+    corner_uv: np.ndarray
+    tracks: list[StrokeTrack]
+    polished: bool
+
+
+def _polish_passes(
+    model: ClothModel,
+    state: ClothState,
+    collider: BodyCollider,
+    p: WrapParams,
+    welded,
+    tracks: list[StrokeTrack],
+    tethers: Tethers | None,
+    loose: np.ndarray,
+    unheld: np.ndarray,
+    pins: np.ndarray,
+) -> _Finished:
+    """Step 7: up to `polish.passes` polishes (`_polish_step`; a later one only while the max strain is over
+    MAX_STRAIN_TARGET: it starts from the better cloth and takes another path to the buckles), each kept only where
+    better. A refining polish gives the garment new faces: the state, pieces, uv and stroke tracks follow them.
+    `unheld` (V,) bool: the pins the polish holds."""
+    out = _Finished(state, model, welded.piece_faces, welded.rest_corners, tracks, False)
+    # The stroke samples of the garment as it is, or of the refined polish rp made of it (moved onto its new faces:
+    # between their old corners they lie off the refined surface).
+    refined_tracks: dict[int, tuple] = {}  # id(rp) -> (its PieceOrdered, the tracks on it): made once, used twice
+
+    def on_refined(rp: RefinedPolish) -> tuple:
+        if id(rp) not in refined_tracks:
+            ordered = pieces_contiguous(rp, out.piece_faces)
+            refined_tracks.clear()
+            refined_tracks[id(rp)] = (
+                ordered,
+                [remap_track(tr, out.corner_uv, out.piece_faces, ordered) for tr in out.tracks],
+            )
+        return refined_tracks[id(rp)]
+
+    def residual_of(positions: np.ndarray, rp: RefinedPolish | None = None) -> np.ndarray:
+        if rp is None or not rp.levels:
+            return np.array([tr.residual_m(positions, out.model.faces) for tr in out.tracks])
+        ordered, moved = on_refined(rp)
+        return np.array([tr.residual_m(positions, ordered.model.faces) for tr in moved])
+
+    settings = p.polish_settings()
+    passes = 0
+    level = pending = None
+    while settings.rounds and passes < settings.passes:
+        if passes and strain(out.state.positions, out.model.edges, out.model.rest_lengths).max <= MAX_STRAIN_TARGET:
+            break
+        passes += 1
+        held = np.concatenate([unheld, np.zeros(out.model.n_vertices - len(unheld), dtype=bool)])
+        kept, rp = polish_step(
+            out.model,
+            out.state.holding(held),
+            collider,
+            settings,
+            tethers=tethers,
+            corner_data={"uv": out.corner_uv},
+            residual_of=residual_of,
+            level=level,
+            pending=pending,
+        )
+        if not kept:
+            break
+        out.polished = True
+        out.state = rp.state
+        if rp.levels:
+            ordered, out.tracks = on_refined(rp)
+            out.state = reorder_state(out.state, ordered)
+            level, pending = ordered.level, ordered.pending
+            out.model, out.piece_faces, out.corner_uv = ordered.model, ordered.piece_faces, ordered.corner_uv
+            if tethers is not None:  # a later pass holds the strokes on the refined faces
+                tethers = _tethers(out.tracks, loose, out.model.faces, p.tethers.reach_m)
+    return out

@@ -221,7 +221,7 @@ def default_simulation_kimono(body=None, pattern=None, edge_cm: float = SIMULATI
     from ..dressing.wrap import WrapParams
     from ..pattern import default_kimono
 
-    params = WrapParams(edge_length_cm=edge_cm, polish_refine_levels=0)
+    params = WrapParams(edge_length_cm=edge_cm).changed({"polish.levels": 0})
     return dress_kimono(default_kimono() if pattern is None else pattern, body, params=params)
 
 
