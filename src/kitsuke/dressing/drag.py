@@ -82,7 +82,6 @@ from ..cloth import (
     collide,
     relax,
     track,
-    untangle,
 )
 from ..errors import InputError
 from ..geometry import TriMesh
@@ -92,6 +91,7 @@ from ._drag_field import body_axis, capsule_limbs, drag_weights, nearest_capsule
 from ._polish_step import PolishSettings, polish_step
 from ._refined import pieces_contiguous, reorder_state
 from ._solve import GlobalRelax
+from ._stages import Untangling, untangle_stage, until_still
 from .export import GarmentFile, as_garment_file
 from .wrap import DressedGarment, offset_as_dressed
 
@@ -125,7 +125,7 @@ class DragParams:
         sleeve at the forearm after one update).
     contact_weight : weight (relative to one triangle edge) of the body contacts inside each global step: a vertex
         touching the body is held on the plane of its contact (normal direction only, so cloth slides; released
-        where the solve pulls it off), as in the wrap's close (`WrapParams.contact_weight`), but only where the
+        where the solve pulls it off), as in the wrap's close (`CloseSettings.contact_weight`), but only where the
         cloth touches the body (the close also draws in cloth within the contact distance). 0 applies collision
         only after each step, which fights the step where it pulls cloth round a leg into the body: the 2.5 cm
         kimono dragged 10 cm up and down three times (benchmarks/bench_drag.py) tore round the shins, 206 % max
@@ -441,7 +441,6 @@ class DragSession:
             self._new_feet()
         else:
             self.state.positions[:] = snap.state.positions
-            self.state.pinned = snap.state.pinned.copy()
             self.state.contacts = snap.state.copy().contacts
         self._feet.contacts = snap.feet.copy().contacts
         self.pinned = snap.pinned.copy()
@@ -471,7 +470,8 @@ class DragSession:
             piece_faces=ordered.piece_faces,
             face_layer=ordered.model.face_layer,
         )
-        self.model, self.state = ordered.model, state
+        # The session's own state holds no pins: each step is given the ones it holds.
+        self.model, self.state = ordered.model, state.holding(np.zeros(ordered.model.n_vertices, dtype=bool))
         self._refinement = (ordered.level, ordered.pending)
         self.pinned = np.concatenate([self.pinned, np.zeros(self.model.n_vertices - len(self.pinned), dtype=bool)])
         self._new_feet()
@@ -587,27 +587,19 @@ class DragSession:
         held[g] = True
         self.grabbed, self._solver = None, None
         p = self.params
-        self.state.pinned = held
+        holding = self.state.holding(held)
         if p.release_steps:
             solver = self._global_solver(held)
-            for _ in range(p.release_steps):
-                if self._global_step(solver) < p.release_tolerance_m:
-                    break
+            until_still(lambda: self._global_step(solver, holding), p.release_steps, p.release_tolerance_m)
         if p.release_relax_iterations:
-            relax(self.model, self.state, self.collider, iterations=p.release_relax_iterations)
-        if p.release_untangle_rounds:
-            untangle(
-                self.model,
-                self.state,
-                self.collider,
-                rounds=p.release_untangle_rounds,
-                iterations=p.release_untangle_iterations,
-            )
+            relax(self.model, holding, self.collider, iterations=p.release_relax_iterations)
+        untangling = Untangling(p.release_untangle_rounds, iterations=p.release_untangle_iterations)
+        untangle_stage(self.model, holding, self.collider, untangling)
         m = self.model
         stats = ReleaseStats(strain_max=strain(self.state.positions, m.edges, m.rest_lengths).max)
         let_go = self.state.positions[g].copy()
         polish = p.release_polish_rounds and stats.strain_max > p.release_polish_above
-        polished = self._release_polish(g) if polish else None
+        polished = self._release_polish(g, held) if polish else None
         if polished is not None and polished.levels:
             self._adopt(polished)  # new feet, tracked
         else:
@@ -618,14 +610,13 @@ class DragSession:
         if polished is not None:
             stats.polished = True
             stats.new_vertices = self.n_vertices - m.n_vertices
-            self.state.pinned = np.concatenate([held, np.zeros(self.n_vertices - len(held), dtype=bool)])
             stats.grab_gave_m = float(np.linalg.norm(self.state.positions[g] - let_go))
             stats.strain_max = strain(self.state.positions, self.model.edges, self.model.rest_lengths).max
         stats.seconds = time.perf_counter() - t0
         return stats
 
-    def _release_polish(self, g: int) -> RefinedPolish | None:
-        """The release's polish (`_polish_step`) of the held cloth (`state.pinned`, `g` the let-go point among it):
+    def _release_polish(self, g: int, held: np.ndarray) -> RefinedPolish | None:
+        """The release's polish (`_polish_step`) of the cloth, `held` (V,) bool still (`g` the let-go point among it):
         with g held; if that leaves the max strain above `release_polish_above`, with g tethered within each of
         `release_give_m` in turn; if none of those is kept, once more held without refinement (refining cloth
         crushed into an armpit can tear it: GarmentCode's shirt, its front hem lifted 5 cm against a pin in the
@@ -643,7 +634,7 @@ class DragSession:
         )
         best, best_max = None, math.inf
         for give in (0.0, *p.release_give_m):
-            polished = self._polish_try(g, settings, give)
+            polished = self._polish_try(g, held, settings, give)
             if polished is None:
                 continue
             worst = strain(polished.state.positions, polished.model.edges, polished.model.rest_lengths).max
@@ -652,14 +643,14 @@ class DragSession:
             if worst <= p.release_polish_above:
                 break
         if best is None and p.release_polish_levels:
-            best = self._polish_try(g, dataclasses.replace(settings, levels=0), 0.0)
+            best = self._polish_try(g, held, dataclasses.replace(settings, levels=0), 0.0)
         return best
 
-    def _polish_try(self, g: int, settings: PolishSettings, give: float) -> RefinedPolish | None:
-        """One polish of the held cloth, g held (give 0) or tethered within `give` metres: the RefinedPolish if
-        `polish_step` keeps it, else None. The session's state is left as it was."""
+    def _polish_try(self, g: int, held: np.ndarray, settings: PolishSettings, give: float) -> RefinedPolish | None:
+        """One polish of the cloth, `held` (V,) bool still, g held (give 0) or tethered within `give` metres: the
+        RefinedPolish if `polish_step` keeps it, else None. The session's state is left as it was."""
         m = self.model
-        held = self.state.pinned.copy()
+        pins = held.copy()
         tethers = None
         if give:
             face = int(np.flatnonzero((m.faces == g).any(axis=1))[0])
@@ -667,22 +658,18 @@ class DragSession:
             tethers = Tethers.from_polylines(
                 [(np.array([face]), bary, self.state.positions[g][None].copy())], m.faces, give
             )
-            self.state.pinned = held.copy()
-            self.state.pinned[g] = False
+            pins[g] = False
         level, pending = self._refinement
-        try:
-            kept, polished = polish_step(
-                m,
-                self.state,
-                self.collider,
-                settings,
-                tethers=tethers,
-                corner_data={"uv": m.rest_corners},
-                level=level,
-                pending=pending,
-            )
-        finally:
-            self.state.pinned = held
+        kept, polished = polish_step(
+            m,
+            self.state.holding(pins),
+            self.collider,
+            settings,
+            tethers=tethers,
+            corner_data={"uv": m.rest_corners},
+            level=level,
+            pending=pending,
+        )
         return polished if kept else None
 
     def _global_solver(self, held: np.ndarray) -> GlobalRelax:
@@ -693,18 +680,19 @@ class DragSession:
             self.model, held, contact_weight=p.contact_weight, contact_reach_m=reach, cg_iterations=p.contact_iterations
         )
 
-    def _global_step(self, solver: GlobalRelax) -> float:
-        """One global relaxation step, each vertex's move clamped to `max_relax_move_m`, then collision. Returns
-        the largest move, metres (before the clamp)."""
-        pos = self.state.positions
+    def _global_step(self, solver: GlobalRelax, holding: ClothState) -> float:
+        """One global relaxation step of the session's cloth (`holding`: its state with the drag's pins), each
+        vertex's move clamped to `max_relax_move_m`, then collision. Returns the largest move, metres (before the
+        clamp)."""
+        pos = holding.positions
         before = pos.copy()
-        largest = solver.step(self.state, self.collider, then_collide=False)
+        largest = solver.step(holding, self.collider, then_collide=False)
         step = pos - before
         length = np.linalg.norm(step, axis=1)
         over = length > self.params.max_relax_move_m
         if over.any():
             pos[over] = before[over] + step[over] * (self.params.max_relax_move_m / length[over])[:, None]
-        collide(self.model, self.state, self.collider)
+        collide(self.model, holding, self.collider)
         return largest
 
     # -- moves ----------------------------------------------------------------------------------------------
@@ -822,12 +810,12 @@ class DragSession:
         self._moved = True
         held = grab.held.copy()
         held[g] = True
-        self.state.pinned = held
+        holding = self.state.holding(held)
         if self._solver is not None:
             if p.contact_weight > 0:  # the contact planes where the cloth is now, not where it was
-                collide(m, self.state, self.collider)
+                collide(m, holding, self.collider)
             for _ in range(p.global_steps):
-                self._global_step(self._solver)
+                self._global_step(self._solver, holding)
         if p.relax_iterations:
-            relax(m, self.state, self.collider, iterations=p.relax_iterations)
+            relax(m, holding, self.collider, iterations=p.relax_iterations)
         self._track_feet()

@@ -8,7 +8,7 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
 
 1. **Transfer** (`_place`): the pattern triangles each pattern stroke crosses are laid on the body along its body
    stroke, at the cloth's own length with the middles together (the body stroke continued straight past its ends
-   where it is shorter; offsets across the stroke laid out on the surface; `lift_m` off it), the body stroke
+   where it is shorter; offsets across the stroke laid out on the surface; `grow.lift_m` off it), the body stroke
    taken the way round the placement or the pattern's up says.
 2. **Growth** (`_grow`): the rest of the garment grows ring by ring from the placed triangles, each new triangle
    unfolded from its placed neighbour (from the cloth, not the body), with relaxation and collision between rings.
@@ -17,31 +17,35 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
    of one piece meet are repaired first, `repair_corners`), so where two grown regions meet at a seam the
    triangles between them are stretched. A closing relaxation without gravity (`_solve.GlobalRelax`: a global
    least-squares solve per iteration, which removes such garment-wide distortion in tens of iterations where the
-   Jacobi `relax` needs thousands) pulls them shut, the strokes only softly held (`stroke_hold`). Where edges
+   Jacobi `relax` needs thousands) pulls them shut, the strokes only softly held (`close.stroke_hold`). Where edges
    are still over twice their length after it (growth took the cloth round the wrong side of a limb), that
-   cloth is grown again from the closed cloth around it and closed again (`_mend`, `tear_strain`).
-4. **Settle**: relaxation with gravity and collision, the stroke pins released (or, `settle="global"`, global
+   cloth is grown again from the closed cloth around it and closed again (`_mend`, `close.tear_strain`).
+4. **Settle**: relaxation with gravity and collision, the stroke pins released (or, `settle.method="global"`, global
    steps with gravity, the body contacts inside the solve and static friction: `_solve.gravity_settle`).
    Optionally a band of the garment (e.g. where a kimono's obi goes) is held: its vertices over the torso are
    pinned where they are after step 3 (`_band_held`), for the settle only (the finish has no gravity).
 5. **Finish**: Gauss-Seidel sweeps projecting each edge to its rest length, Chebyshev-accelerated, take back the
-   stretch the settle's gravity left in cloth resting on the body and the local strain (`length_sweeps`,
-   `length_chebyshev_rho`, `kitsuke.cloth.restore_lengths`; optionally after a few global relaxation steps
-   without gravity, `finish_iterations`, 0 by default). The sweeps also pull each pattern stroke back within
-   `stroke_reach_m` of its body stroke where the settle let it hang farther (one-sided tethers,
+   stretch the settle's gravity left in cloth resting on the body and the local strain (`lengths`,
+   `kitsuke.cloth.restore_lengths`; optionally after a few global relaxation steps without gravity,
+   `lengths.finish_iterations`, 0 by default). The sweeps also pull each pattern stroke back within
+   `tethers.reach_m` of its body stroke where the settle let it hang farther (one-sided tethers,
    `kitsuke.cloth.Tethers`), so the strokes are met and the rest drapes freely.
 6. **Untangle** (`kitsuke.cloth.untangle`, also run at the end of step 3, before a hold band is pinned):
    triangles still folded over their neighbours are opened by relaxing only a few rings of cloth around them,
-   the rest of the garment held still (`untangle_rounds`); the stroke tethers still apply.
+   the rest of the garment held still (`untangle.rounds`); the stroke tethers still apply.
 7. **Polish** (`kitsuke.cloth.polish_refined`, through `_polish_step`): an L-BFGS minimisation of one energy over
    the garment (edge springs with a barrier past 2 % strain, quadratic bending, contact planes, the stroke
    tethers, the layer order) lets compressed cloth buckle into wrinkles and spreads stretch; strain-limit sweeps
    then pull the few edges it left over 4.5 % back to it; where triangles are left folded, the cloth around them
-   is refined (adaptive sqrt(3), up to `polish_refine_levels`) and polished again, so the crease becomes a
+   is refined (adaptive sqrt(3), up to `polish.levels`) and polished again, so the crease becomes a
    wrinkle of finer triangles; the untangle opens what is still folded. The result is kept only where it is
    better: lower max strain, and mean strain, stroke residual, folds and layer order no worse than before or
    than the targets (1 %, 10 mm, none, the layer gap). While the max strain is over 5 %, a second pass. A refined
    garment has more faces than its pattern mesh (`DressedGarment.faces`).
+
+Steps 2-6 are stages of `_stages` (`stage(model, state, collider, config) -> stats`, each given the pins it holds
+as a view of the state, timed, announced to `progress` and checked for non-finite positions); their settings are
+`WrapParams`' groups (`wrap_settings`), one per stage.
 
 Layered cloth (a pattern's `meta["layers"]`: the kimono's left front over its right, SPEC §5.4) keeps its layer
 order in every collision update of every step (`kitsuke.cloth.keep_layers`), so the fronts never grow or settle
@@ -107,9 +111,9 @@ class DressedGarment:
     stroke_ids : stroke ids in drawing order. stroke_residual_m : (S,) float64 metres, for each stroke the largest
         distance of its pattern stroke (on the garment) to its body stroke after the settle.
     stroke_length_ratio : (S,) body stroke length / pattern stroke length (the cloth keeps its own length).
-    loose_strokes : ids of the strokes not held to their body strokes after the settle (`tether_slack_m`).
+    loose_strokes : ids of the strokes not held to their body strokes after the settle (`TetherSettings.slack_m`).
     rings : growth rings. mend : what `_mend.mend_tears` did after the close (rounds, torn edges before and
-        after). polished : the polish's result was kept (`WrapParams.polish_rounds`). timings : seconds per step
+        after). polished : the polish's result was kept (`PolishSettings.rounds`). timings : seconds per step
         ("mesh", "resolve", "place", "grow", "close", "settle", "finish", "untangle", "polish", "wrap" = all of
         them, "report").
     report : the SPEC §6 quality report against the body.
@@ -408,6 +412,7 @@ def wrap(
         # Strokes the cloth cannot lie along without stretching (a shirt's strokes drawn 2 cm below where its
         # shoulders can go: 46 % max strain held there, 4.6 % let go): the same steps without their tethers, kept
         # when they halve the max strain and end within twice its target; the strokes are then reported loose.
+        log.say("trying without the stroke tethers")
         free_done = finish_and_polish(settled_state, None, np.ones_like(loose))
         loose_max = strain(free_done.state.positions, free_done.model.edges, free_done.model.rest_lengths).max
         if loose_max < 0.5 * held and loose_max <= 2 * MAX_STRAIN_TARGET:
