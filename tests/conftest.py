@@ -1,13 +1,31 @@
-"""Shared test helpers: the in-repo data folder and an in-process CLI runner."""
+"""Shared test helpers: the in-repo data folder, an in-process CLI runner and the Khronos glTF validator."""
 
 from __future__ import annotations
 
+import json
+import os
+import shutil
+import subprocess
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
 DATA = Path(__file__).parent / "data"
+ROOT = Path(__file__).resolve().parent.parent
+#: The Khronos glTF validator, as `.ci/run` installs it (npm gltf-validator under .ci/node).
+GLTF_VALIDATOR = ROOT / ".ci" / "node" / "node_modules" / "gltf-validator"
+needs_gltf_validator = pytest.mark.skipif(
+    not GLTF_VALIDATOR.exists() or shutil.which("node") is None, reason="gltf-validator not installed"
+)
+
+
+def gltf_report(path: Path) -> dict:
+    """The Khronos validator's summary of a .glb file: {"errors", "warnings", "messages"}."""
+    env = {**os.environ, "NODE_PATH": str(GLTF_VALIDATOR.parent)}
+    script = ROOT / "tests" / "tools" / "validate_gltf.js"
+    r = subprocess.run(["node", str(script), str(path)], capture_output=True, text=True, env=env, check=True)
+    return json.loads(r.stdout)
 
 
 @dataclass

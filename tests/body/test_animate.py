@@ -4,10 +4,7 @@ here in numpy, and checked by the Khronos validator where it is installed)."""
 from __future__ import annotations
 
 import json
-import os
-import shutil
 import struct
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -21,9 +18,10 @@ from kitsuke.body.skinning import skin
 from kitsuke.pose import PoseSequence, load_bvh
 from kitsuke.skeleton import BONES, INDEX, JOINTS, PARENT_INDEX
 
+from ..conftest import gltf_report, needs_gltf_validator
+
 ROOT = Path(__file__).resolve().parent.parent.parent
 KICK = ROOT / "tests" / "data" / "pose" / "cmu_10_01_soccer_kick_mh.bvh"
-VALIDATOR = ROOT / ".ci" / "node" / "node_modules" / "gltf-validator"
 
 
 @pytest.fixture(scope="module")
@@ -169,14 +167,10 @@ def test_glb_plays_back_the_same_skin(body, kick):
     assert np.abs(played - posed_vertices(body, anim, frame)).max() < 1e-4
 
 
-@pytest.mark.skipif(not VALIDATOR.exists() or shutil.which("node") is None, reason="gltf-validator not installed")
+@needs_gltf_validator
 def test_glb_passes_the_khronos_validator(body, kick, tmp_path):
     _, anim = kick
-    path = write_animated_glb(body, anim, tmp_path / "kick.glb")
-    script = ROOT / "tests" / "tools" / "validate_gltf.js"
-    env = {**os.environ, "NODE_PATH": str(VALIDATOR.parent)}
-    r = subprocess.run(["node", str(script), str(path)], capture_output=True, text=True, env=env)
-    report = json.loads(r.stdout)
+    report = gltf_report(write_animated_glb(body, anim, tmp_path / "kick.glb"))
     assert report["errors"] == 0 and report["warnings"] == 0, report["messages"]
 
 

@@ -4,7 +4,7 @@ import pytest
 from kitsuke.errors import InputError
 from kitsuke.geometry import TriMesh, clean_mesh, load_mesh, read_mesh, save_mesh
 
-from ..conftest import DATA
+from ..conftest import DATA, gltf_report, needs_gltf_validator
 
 
 def quad_obj(tmp_path, text):
@@ -38,6 +38,22 @@ def test_roundtrip_obj_glb_ply_keeps_geometry(tmp_path):
         assert back.n_faces == body.n_faces, suffix
         assert back.n_vertices == body.n_vertices, suffix
         np.testing.assert_allclose(np.sort(back.vertices, axis=0), np.sort(body.vertices, axis=0), atol=2e-6)
+
+
+@needs_gltf_validator
+def test_glb_of_a_textured_and_a_plain_mesh_passes_the_khronos_validator(tmp_path):
+    """kitsuke writes its GLBs itself: names, normals, uv and an embedded texture, valid for every viewer."""
+    body = load_mesh(DATA / "bodies" / "mean_all.obj")
+    checker = np.kron([[0, 255], [255, 0]], np.ones((8, 8)))[..., None].repeat(3, axis=2).astype(np.uint8)
+    cloth = TriMesh(
+        [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2], [0, 2, 3]], uv=[[0, 0], [2, 0], [2, 2], [0, 2]],
+        name="cloth", texture=checker,
+    )  # fmt: skip
+    path = save_mesh([body, cloth], tmp_path / "scene.glb")
+    report = gltf_report(path)
+    assert report["errors"] == 0 and report["warnings"] == 0, report["messages"]
+    back = load_mesh(path)  # read back by trimesh, as other tools read it
+    assert back.n_faces == body.n_faces + 2
 
 
 def test_uv_survives_obj_roundtrip(tmp_path):

@@ -5,10 +5,8 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import os
 import shutil
 import struct
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -34,10 +32,11 @@ from kitsuke.tryon import (
 )
 from kitsuke.tryon.outputs import write_kimono_glb
 
+from ..conftest import GLTF_VALIDATOR, gltf_report
+
 ROOT = Path(__file__).resolve().parents[2]
 WALK = ROOT / "tests" / "data" / "pose" / "cmu_131_01_start_walk_stop.bvh"
 SHIRT = ROOT / "tests" / "data" / "pattern" / "shirt_mean_specification.json"
-VALIDATOR = ROOT / ".ci" / "node" / "node_modules" / "gltf-validator"
 SHORT = SimulationSettings(hold_s=0.1, blend_s=0.3)
 
 
@@ -184,16 +183,8 @@ def test_the_animated_glb_plays_the_body_and_the_kimono(tmp_path, body, motion):
     k = n - 1
     shown = base + _accessor(doc, binary, prim["targets"][k]["POSITION"])
     np.testing.assert_allclose(shown, motion.positions[k][index], atol=1e-5)
-    if VALIDATOR.exists() and shutil.which("node"):
-        env = dict(os.environ, NODE_PATH=str(VALIDATOR.parent))
-        out = subprocess.run(
-            ["node", str(ROOT / "tests" / "tools" / "validate_gltf.js"), str(path)],
-            capture_output=True,
-            text=True,
-            env=env,
-            check=True,
-        )
-        report = json.loads(out.stdout)
+    if GLTF_VALIDATOR.exists() and shutil.which("node"):
+        report = gltf_report(path)
         assert report["errors"] == 0 and report["warnings"] == 0, report["messages"]
 
 

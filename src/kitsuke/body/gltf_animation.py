@@ -13,9 +13,7 @@ and three.js plays them (morph targets kept in a texture, so their number has no
 
 from __future__ import annotations
 
-import json
 import os
-import struct
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,12 +21,18 @@ import numpy as np
 
 from .._files import atomic_path
 from ..geometry import TriMesh
+from ..geometry.gltf import (
+    ARRAY_BUFFER,
+    ELEMENT_ARRAY_BUFFER,
+    FLOAT,
+    UINT,
+    USHORT,
+    GltfBuffer,
+    glb_bytes,
+    vertex_normals,
+)
 from ..skeleton import JOINTS, PARENT_INDEX
 from .animate import BodyAnimation
-
-_FLOAT, _USHORT, _UINT = 5126, 5123, 5125
-_ARRAY, _ELEMENTS = 34962, 34963
-_REPEAT, _LINEAR_MIPMAP, _LINEAR = 10497, 9987, 9729
 
 
 @dataclass
@@ -41,34 +45,6 @@ class MorphMesh:
 
     mesh: TriMesh
     frames: np.ndarray
-
-
-class _Buffer:
-    """The GLB's binary chunk and its accessors, built up one array at a time."""
-
-    def __init__(self) -> None:
-        self.data = bytearray()
-        self.views: list[dict] = []
-        self.accessors: list[dict] = []
-
-    def add(self, array: np.ndarray, kind: str, component: int, *, target: int | None = None, bounds: bool = False):
-        """Append `array` (count, ...) as an accessor of `kind` ("VEC3", "MAT4", ...); returns its index."""
-        dtype = {_FLOAT: "<f4", _USHORT: "<u2", _UINT: "<u4"}[component]
-        raw = np.ascontiguousarray(array, dtype=dtype)
-        while len(self.data) % 4:
-            self.data.append(0)
-        view = {"buffer": 0, "byteOffset": len(self.data), "byteLength": raw.nbytes}
-        if target is not None:
-            view["target"] = target
-        self.data += raw.tobytes()
-        self.views.append(view)
-        acc = {"bufferView": len(self.views) - 1, "componentType": component, "count": len(raw), "type": kind}
-        if bounds:
-            flat = raw.reshape(len(raw), -1)
-            acc["min"] = [float(x) for x in flat.min(axis=0)]
-            acc["max"] = [float(x) for x in flat.max(axis=0)]
-        self.accessors.append(acc)
-        return len(self.accessors) - 1
 
 
 def _quaternions(rotations: np.ndarray) -> np.ndarray:
@@ -94,24 +70,22 @@ def _top4(weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def animated_glb(body, animation: BodyAnimation, cloth: MorphMesh | None = None) -> bytes:  # noqa: ANN001 - a rigged Body
     """The GLB bytes of `body` skinned and moved by `animation`, and `cloth` moving with it (optional)."""
     mesh, rig = body.mesh, body.rig
-    buf = _Buffer()
-    normals = _vertex_normals(mesh.vertices, mesh.faces)
+    buf = GltfBuffer()
+    normals = vertex_normals(mesh.vertices, mesh.faces)
     joints4, weights4 = _top4(animation.weights)
     attributes = {
-        "POSITION": buf.add(mesh.vertices, "VEC3", _FLOAT, target=_ARRAY, bounds=True),
-        "NORMAL": buf.add(normals, "VEC3", _FLOAT, target=_ARRAY),
-        "JOINTS_0": buf.add(joints4, "VEC4", _USHORT, target=_ARRAY),
-        "WEIGHTS_0": buf.add(weights4, "VEC4", _FLOAT, target=_ARRAY),
+        "POSITION": buf.add(mesh.vertices, "VEC3", FLOAT, target=ARRAY_BUFFER, bounds=True),
+        "NORMAL": buf.add(normals, "VEC3", FLOAT, target=ARRAY_BUFFER),
+        "JOINTS_0": buf.add(joints4, "VEC4", USHORT, target=ARRAY_BUFFER),
+        "WEIGHTS_0": buf.add(weights4, "VEC4", FLOAT, target=ARRAY_BUFFER),
     }
     if mesh.uv is not None:
-        attributes["TEXCOORD_0"] = buf.add(
-            np.column_stack([mesh.uv[:, 0], 1.0 - mesh.uv[:, 1]]), "VEC2", _FLOAT, target=_ARRAY
-        )
-    indices = buf.add(mesh.faces.reshape(-1), "SCALAR", _UINT, target=_ELEMENTS)
+        attributes["TEXCOORD_0"] = buf.add_uv(mesh.uv)
+    indices = buf.add(mesh.faces.reshape(-1), "SCALAR", UINT, target=ELEMENT_ARRAY_BUFFER)
     # inverse bind matrices: the joints' rest frames are translations only (column-major 4x4)
     ibm = np.tile(np.eye(4), (len(JOINTS), 1, 1))
     ibm[:, :3, 3] = -rig.joints
-    ibm_acc = buf.add(ibm.transpose(0, 2, 1).reshape(len(JOINTS), 16), "MAT4", _FLOAT)
+    ibm_acc = buf.add(ibm.transpose(0, 2, 1).reshape(len(JOINTS), 16), "MAT4", FLOAT)
 
     first_joint = 1  # node 0 is the skinned mesh
     nodes: list[dict] = [{"name": "body", "mesh": 0, "skin": 0}]
@@ -124,14 +98,14 @@ def animated_glb(body, animation: BodyAnimation, cloth: MorphMesh | None = None)
             node["children"] = kids
         nodes.append(node)
 
-    times = buf.add(animation.times - animation.times[0], "SCALAR", _FLOAT, bounds=True)
+    times = buf.add(animation.times - animation.times[0], "SCALAR", FLOAT, bounds=True)
     local = animation.local_rotations
     samplers, channels = [], []
     for j in range(len(JOINTS)):
-        out = buf.add(_quaternions(local[:, j]), "VEC4", _FLOAT)
+        out = buf.add(_quaternions(local[:, j]), "VEC4", FLOAT)
         samplers.append({"input": times, "output": out, "interpolation": "LINEAR"})
         channels.append({"sampler": len(samplers) - 1, "target": {"node": first_joint + j, "path": "rotation"}})
-    root = buf.add(animation.joints[:, 0], "VEC3", _FLOAT)
+    root = buf.add(animation.joints[:, 0], "VEC3", FLOAT)
     samplers.append({"input": times, "output": root, "interpolation": "LINEAR"})
     channels.append({"sampler": len(samplers) - 1, "target": {"node": first_joint, "path": "translation"}})
 
@@ -151,7 +125,7 @@ def animated_glb(body, animation: BodyAnimation, cloth: MorphMesh | None = None)
         roots.append(len(nodes))
         nodes.append({"name": cloth.mesh.name or "cloth", "mesh": 1})
         _add_morph_mesh(buf, doc, meshes, materials, cloth)
-        weights = buf.add(np.eye(animation.n_frames, dtype=np.float32).reshape(-1), "SCALAR", _FLOAT)
+        weights = buf.add(np.eye(animation.n_frames, dtype=np.float32).reshape(-1), "SCALAR", FLOAT)
         samplers.append({"input": times, "output": weights, "interpolation": "LINEAR"})
         channels.append({"sampler": len(samplers) - 1, "target": {"node": roots[-1], "path": "weights"}})
 
@@ -174,17 +148,17 @@ def animated_glb(body, animation: BodyAnimation, cloth: MorphMesh | None = None)
         "bufferViews": buf.views,
         "accessors": buf.accessors,
     }
-    return _glb(doc, bytes(buf.data))
+    return glb_bytes(doc, bytes(buf.data))
 
 
-def _add_morph_mesh(buf: _Buffer, doc: dict, meshes: list, materials: list, cloth: MorphMesh) -> None:
+def _add_morph_mesh(buf: GltfBuffer, doc: dict, meshes: list, materials: list, cloth: MorphMesh) -> None:
     """Append the cloth's mesh (one morph target per frame) and its material (textured if it has one)."""
     mesh = cloth.mesh
     base = np.asarray(cloth.frames[0], dtype=np.float64)
-    base_n = _vertex_normals(base, mesh.faces)
+    base_n = vertex_normals(base, mesh.faces)
     attributes = {
-        "POSITION": buf.add(base, "VEC3", _FLOAT, target=_ARRAY, bounds=True),
-        "NORMAL": buf.add(base_n, "VEC3", _FLOAT, target=_ARRAY),
+        "POSITION": buf.add(base, "VEC3", FLOAT, target=ARRAY_BUFFER, bounds=True),
+        "NORMAL": buf.add(base_n, "VEC3", FLOAT, target=ARRAY_BUFFER),
     }
     material: dict = {
         "name": mesh.name or "cloth",
@@ -192,60 +166,23 @@ def _add_morph_mesh(buf: _Buffer, doc: dict, meshes: list, materials: list, clot
         "doubleSided": True,
     }
     if mesh.uv is not None:
-        attributes["TEXCOORD_0"] = buf.add(
-            np.column_stack([mesh.uv[:, 0], 1.0 - mesh.uv[:, 1]]), "VEC2", _FLOAT, target=_ARRAY
-        )
+        attributes["TEXCOORD_0"] = buf.add_uv(mesh.uv)
     if mesh.uv is not None and mesh.texture is not None:
-        import io
-
-        from PIL import Image
-
-        png = io.BytesIO()
-        Image.fromarray(np.asarray(mesh.texture, dtype=np.uint8)).save(png, format="PNG")
-        while len(buf.data) % 4:
-            buf.data.append(0)
-        buf.views.append({"buffer": 0, "byteOffset": len(buf.data), "byteLength": len(png.getvalue())})
-        buf.data += png.getvalue()
-        doc["images"] = [{"bufferView": len(buf.views) - 1, "mimeType": "image/png"}]
-        doc["samplers"] = [{"magFilter": _LINEAR, "minFilter": _LINEAR_MIPMAP, "wrapS": _REPEAT, "wrapT": _REPEAT}]
-        doc["textures"] = [{"source": 0, "sampler": 0}]
-        material["pbrMetallicRoughness"] = {"baseColorTexture": {"index": 0}, "metallicFactor": 0.0}
+        texture = buf.add_texture(doc, mesh.texture)
+        material["pbrMetallicRoughness"] = {"baseColorTexture": {"index": texture}, "metallicFactor": 0.0}
     targets = []
     for frame in cloth.frames:
         f = np.asarray(frame, dtype=np.float64)
         targets.append(
             {
-                "POSITION": buf.add(f - base, "VEC3", _FLOAT, target=_ARRAY, bounds=True),
-                "NORMAL": buf.add(_vertex_normals(f, mesh.faces) - base_n, "VEC3", _FLOAT, target=_ARRAY),
+                "POSITION": buf.add(f - base, "VEC3", FLOAT, target=ARRAY_BUFFER, bounds=True),
+                "NORMAL": buf.add(vertex_normals(f, mesh.faces) - base_n, "VEC3", FLOAT, target=ARRAY_BUFFER),
             }
         )
-    indices = buf.add(mesh.faces.reshape(-1), "SCALAR", _UINT, target=_ELEMENTS)
+    indices = buf.add(mesh.faces.reshape(-1), "SCALAR", UINT, target=ELEMENT_ARRAY_BUFFER)
     primitive = {"attributes": attributes, "indices": indices, "material": len(materials), "targets": targets}
     meshes.append({"name": mesh.name or "cloth", "primitives": [primitive], "weights": [0.0] * len(targets)})
     materials.append(material)
-
-
-def _vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    n = np.cross(vertices[faces[:, 1]] - vertices[faces[:, 0]], vertices[faces[:, 2]] - vertices[faces[:, 0]])
-    out = np.zeros_like(vertices)
-    for k in range(3):
-        np.add.at(out, faces[:, k], n)
-    return out / np.maximum(np.linalg.norm(out, axis=1, keepdims=True), 1e-12)
-
-
-def _glb(doc: dict, binary: bytes) -> bytes:
-    """A GLB container: header, JSON chunk (space-padded), BIN chunk (zero-padded)."""
-    text = json.dumps(doc, separators=(",", ":")).encode()
-    text += b" " * (-len(text) % 4)
-    binary += b"\0" * (-len(binary) % 4)
-    total = 12 + 8 + len(text) + 8 + len(binary)
-    return (
-        struct.pack("<4sII", b"glTF", 2, total)
-        + struct.pack("<I4s", len(text), b"JSON")
-        + text
-        + struct.pack("<I4s", len(binary), b"BIN\0")
-        + binary
-    )
 
 
 def write_animated_glb(

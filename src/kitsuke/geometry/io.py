@@ -10,6 +10,7 @@ import numpy as np
 from .. import limits
 from .._files import atomic_path, require_file
 from ..errors import InputError
+from .gltf import static_glb
 from .mesh import TriMesh
 from .obj import read_obj
 
@@ -85,8 +86,6 @@ def _load_with_trimesh(p: Path) -> TriMesh:
 
 def save_mesh(mesh: TriMesh | list[TriMesh], path: str | Path) -> Path:
     """Write one or more meshes to OBJ, GLB or PLY (by suffix), atomically. GLB keeps names, UVs and textures."""
-    import trimesh
-
     meshes = mesh if isinstance(mesh, list) else [mesh]
     p = Path(path)
     suffix = p.suffix.lower()
@@ -94,14 +93,12 @@ def save_mesh(mesh: TriMesh | list[TriMesh], path: str | Path) -> Path:
         raise InputError("output must end in .obj, .glb or .ply", p)
     if suffix == ".obj":
         data = _obj_text(meshes).encode()
+    elif suffix == ".glb":
+        data = static_glb(meshes)
     else:
-        scene = trimesh.Scene()
-        for m in meshes:
-            scene.add_geometry(_to_trimesh(m), geom_name=m.name, node_name=m.name)
-        if suffix == ".ply":
-            data = trimesh.util.concatenate([_to_trimesh(m) for m in meshes]).export(file_type="ply")
-        else:
-            data = scene.export(file_type="glb")
+        import trimesh
+
+        data = trimesh.util.concatenate([_to_trimesh(m) for m in meshes]).export(file_type="ply")
     with atomic_path(p) as tmp:
         tmp.write_bytes(data)
     return p
