@@ -16,6 +16,8 @@ from kitsuke.dressing import (
     resolve_strokes,
     suggest_strokes,
 )
+from kitsuke.dressing._far_pieces import drawn_in_placements, seam_rise
+from kitsuke.dressing._polyline import polygon_grid
 from kitsuke.dressing.perturb import scale_polyline
 from kitsuke.dressing.suggest import candidate_strokes
 from kitsuke.errors import InputError
@@ -25,6 +27,16 @@ from kitsuke.pattern import Piece, load_pattern, make_kimono
 from ..conftest import DATA
 
 SHIRT = DATA / "pattern" / "shirt_mean_specification.json"
+CORPUS = DATA / "pattern" / "corpus"
+
+
+def _laid_out(pattern, names, out_m: float, down_m: float = 0.0):
+    """`pattern` with pieces `names` moved `out_m` metres along their outer normal and `down_m` down: laid out
+    far from the body as GarmentCode lays out a wide skirt's panels."""
+    for name in names:
+        pl = pattern.piece(name).placement
+        pl.translation = pl.translation + out_m * pl.normal - [0.0, down_m, 0.0]
+    return pattern
 
 
 @pytest.fixture(scope="module")
@@ -77,6 +89,59 @@ def test_suggest_needs_a_placement_and_a_body_it_was_made_for(mean_all, mean_sur
         piece.placement.translation = piece.placement.translation + [5.0, 0.0, 0.0]
     with pytest.raises(InputError, match="reaches the body"):
         suggest_strokes(mean_all, far, surface=mean_surface)
+
+
+def test_a_skirt_laid_out_far_is_drawn_in_by_its_seams_to_the_waist_and_hips(mean_all, mean_surface):
+    """A skirt laid 1.5 m out and 20 cm low (no normal reaches the body) is drawn in: raised until it meets the
+    waistband it is sewn to, moved in until it touches the body, and stroked from the waist over the hips, each
+    piece on its own side of the body."""
+    skirt = ["skirt_front", "skirt_back"]
+    pattern = _laid_out(load_pattern(CORPUS / "gc_s101_0003_specification.json"), skirt, 1.5, 0.2)
+    moved = drawn_in_placements(pattern, skirt, mean_surface, SuggestParams().reach_m)
+    assert set(moved) == set(skirt)
+    anchors = {name: pattern.piece(name).placement for name in ("wb_front", "wb_back")}
+    for name, (placement, touch_y) in moved.items():
+        drawn = pattern.copy()
+        drawn.piece(name).placement = placement
+        assert abs(seam_rise(drawn, name, anchors)) < 0.005  # its waist seam is where the waistband's is
+        assert 0.7 < touch_y < 1.05  # it touched the hips, not the feet
+        placed = placement.apply(polygon_grid(drawn.piece(name).polygon(), 24))
+        assert mean_surface.closest(placed).distance.min() < 0.02  # it touches the body
+    strokes = suggest_strokes(mean_all, pattern, params=SuggestParams(settle=False), surface=mean_surface)
+    check_strokes(strokes, pattern)
+    by_piece = {p.pattern.piece: p.body.points for p in strokes.pairs}
+    assert set(skirt) <= set(by_piece)
+    assert (by_piece["skirt_front"][:, 2] > 0.03).all() and (by_piece["skirt_back"][:, 2] < -0.03).all()
+    for name in skirt:
+        pts = by_piece[name]
+        assert mean_surface.closest(pts).distance.max() < 0.005
+        assert 0.7 < pts[:, 1].min() and pts[:, 1].max() < 1.1  # waist to hips, not down the legs
+        assert arc_length(pts)[-1] > 0.06
+
+
+def test_a_far_piece_sewn_to_nothing_on_the_body_gets_no_stroke(mean_all, mean_surface):
+    """The seams decide where a far piece goes: a skirt laid out far and sewn only to itself is left out (its
+    waistband, the only piece near the body, is stroked instead)."""
+    pattern = _laid_out(load_pattern(CORPUS / "gc_s101_0003_specification.json"), ["skirt_front", "skirt_back"], 1.5)
+    pattern.seams = [s for s in pattern.seams if not {s.a.piece, s.b.piece} & {"wb_front", "wb_back"}]
+    strokes = suggest_strokes(mean_all, pattern, params=SuggestParams(settle=False), surface=mean_surface)
+    assert {p.pattern.piece for p in strokes.pairs} <= {"wb_front", "wb_back"}
+
+
+def test_when_no_large_piece_reaches_the_body_the_smaller_ones_get_strokes(mean_all, mean_surface):
+    """A dress whose skirt is laid out far (each skirt piece over twice a bodice piece): the bodice pieces, below
+    the share rule (here a half), get strokes, the share rule holding among the pieces that reach the body (the
+    waistband, under half the largest bodice piece, gets none), and the skirt is drawn in below them."""
+    skirt = ["skirt_front", "skirt_back"]
+    pattern = _laid_out(load_pattern(CORPUS / "gc_s101_0009_specification.json"), skirt, 1.5)
+    params = SuggestParams(settle=False, min_area_share=0.5)
+    strokes = suggest_strokes(mean_all, pattern, params=params, surface=mean_surface)
+    check_strokes(strokes, pattern)
+    by_piece = {p.pattern.piece: p.body.points for p in strokes.pairs}
+    torso = {"right_btorso", "right_ftorso", "left_btorso", "left_ftorso"}
+    assert torso <= set(by_piece) and not {"wb_front", "wb_back"} & set(by_piece)
+    assert set(skirt) <= set(by_piece)
+    assert max(by_piece[name][:, 1].max() for name in skirt) < min(by_piece[name][:, 1].min() for name in torso)
 
 
 def test_suggest_for_a_kimono_from_the_generator(body, body_surface):

@@ -125,6 +125,14 @@ def polygon_inside(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
     return ((straddle & (x < xc)).sum(axis=1) % 2) == 1
 
 
+def polygon_grid(polygon: np.ndarray, n: int) -> np.ndarray:
+    """(m, 2): the points of an n x n grid over a polygon's (k, 2) bounding box that lie inside it."""
+    lo, hi = polygon.min(axis=0), polygon.max(axis=0)
+    gx, gy = np.meshgrid(np.linspace(lo[0], hi[0], n), np.linspace(lo[1], hi[1], n))
+    grid = np.c_[gx.ravel(), gy.ravel()]
+    return grid[polygon_inside(grid, polygon)]
+
+
 def polygon_distance(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
     """(n,) distance of points (n, 2) to the boundary of a closed polygon (m, 2), in the points' units."""
     q = np.asarray(points, dtype=np.float64).reshape(-1, 2)

@@ -12,11 +12,19 @@ the torso. The longest run of points that the body continues without a jump beco
 longer of the two strokes is trimmed about its middle so that both have the same length. Last, the garment is
 wrapped once on these strokes and each body stroke moves to where its pattern stroke came to rest
 (`settled_strokes`): a placement is a layout, not where the sewn garment hangs.
+
+Two fallbacks, both after the carry along the normal (so a sleeve that reaches its arm keeps its stroke there):
+
+- when no large piece reaches the body, the smaller ones are tried, largest first, the share rule then holding
+  among those that reach it (a dress whose bodice GarmentCode laid on the body and whose skirt it laid far out);
+- a large piece laid out far from the body (GarmentCode's ring of skirt panels 1-2 m out) is drawn in to it by
+  its seams to the pieces near it (`_far_pieces`) and carried from there, only as far as `drawn_in_reach_m` and
+  `drawn_in_below_m` keep it: from its waist seam over the hips, where the body holds a hanging skirt.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -24,7 +32,8 @@ from ..errors import InputError
 from ..geometry.mesh import TriMesh
 from ..geometry.surface import Surface
 from ..pattern import Pattern, Piece
-from ._polyline import arc_length, interpolate_polyline, polygon_distance, polygon_inside
+from ._far_pieces import drawn_in_placements
+from ._polyline import arc_length, interpolate_polyline, polygon_distance, polygon_grid, polygon_inside
 from .strokes import BodyStroke, PatternStroke, StrokePair, Strokes
 
 #: Grid cells across a piece's bounding box when its area moments are sampled.
@@ -43,6 +52,10 @@ class SuggestParams:
     jump_m : consecutive body points farther apart than this plus twice `step_cm` break the stroke (the line
         ran off one limb onto another), metres.
     min_length_cm : shorter strokes are not suggested, cm.
+    drawn_in_reach_m : a large piece laid out far from the body (no point of it reaches it along its normal) is
+        drawn in to it (`_far_pieces`) and carried at most this far, metres: the part of it the body holds.
+    drawn_in_below_m : ... and no lower than this below where it first touched the body, metres (a skirt panel
+        drawn in touches the hips and hangs free below them; a hand draws a little past the widest point).
     settle : move each body stroke to where its pattern stroke rests once the garment, wrapped on the strokes
         from the placement, has settled (`settled_strokes`), so the strokes ask for what the garment can give.
     """
@@ -54,6 +67,8 @@ class SuggestParams:
     reach_m: float = 0.35
     jump_m: float = 0.02
     min_length_cm: float = 6.0
+    drawn_in_reach_m: float = 0.06
+    drawn_in_below_m: float = 0.10
     settle: bool = True
 
     def __post_init__(self) -> None:
@@ -65,19 +80,14 @@ class SuggestParams:
             and self.reach_m > 0
             and self.jump_m >= 0
             and self.min_length_cm > 0
+            and self.drawn_in_reach_m > 0
+            and self.drawn_in_below_m >= 0
         ):
             raise InputError(
                 "suggest parameters: 0 <= min_area_share <= 1, margin_cm >= 0, 0 <= trim < 0.5, step_cm > 0, "
-                "reach_m > 0, jump_m >= 0, min_length_cm > 0 required"
+                "reach_m > 0, jump_m >= 0, min_length_cm > 0, drawn_in_reach_m > 0, "
+                "drawn_in_below_m >= 0 required"
             )
-
-
-def _area_samples(poly: np.ndarray) -> np.ndarray:
-    """(m, 2) cm: grid points inside a polygon, MOMENT_GRID across its bounding box."""
-    lo, hi = poly.min(axis=0), poly.max(axis=0)
-    gx, gy = np.meshgrid(np.linspace(lo[0], hi[0], MOMENT_GRID), np.linspace(lo[1], hi[1], MOMENT_GRID))
-    grid = np.c_[gx.ravel(), gy.ravel()]
-    return grid[polygon_inside(grid, poly)]
 
 
 def _downwards(axis: np.ndarray) -> np.ndarray:
@@ -116,7 +126,7 @@ def candidate_strokes(piece: Piece, params: SuggestParams) -> list[np.ndarray]:
     """Pattern strokes (n, 2) cm worth trying on a piece, best first: along its long axis (the principal axis of
     its area) and, on a placed piece, along the world's vertical, each through its centroid and through points
     across it (a dart through the centroid, or a side that wraps out of reach, spoils one line, not all)."""
-    inside = _area_samples(piece.polygon())
+    inside = polygon_grid(piece.polygon(), MOMENT_GRID)
     if len(inside) < 3:
         return []
     centre = inside.mean(axis=0)
@@ -182,15 +192,19 @@ def _trim_to(points: np.ndarray, length: float) -> np.ndarray:
     return interpolate_polyline(points, np.linspace(mid - 0.5 * length, mid + 0.5 * length, len(points)))
 
 
-def suggest_pair(piece: Piece, surface: Surface, params: SuggestParams) -> tuple[np.ndarray, np.ndarray] | None:
+def suggest_pair(
+    piece: Piece, surface: Surface, params: SuggestParams, *, lowest_m: float | None = None
+) -> tuple[np.ndarray, np.ndarray] | None:
     """One stroke pair for a placed piece: (pattern points (n, 2) cm in the piece's own coordinates, body points
     (n, 3) metres on the surface), as long as each other: of `candidate_strokes`, the one whose longest part
-    reaches the body; None when none does."""
+    reaches the body; None when none does. lowest_m : placed points below this height (metres) are not carried."""
     best, best_length = None, params.min_length_cm
     for pat in candidate_strokes(piece, params):
         placed, normals = _placed_normals(piece, pat)
         on = carry_to_body(surface, placed, normals, params.reach_m)
         ok = np.isfinite(on).all(axis=1)
+        if lowest_m is not None:
+            ok &= placed[:, 1] >= lowest_m
         step = np.linalg.norm(np.diff(np.where(ok[:, None], on, 0.0), axis=0), axis=1)
         joined = ok[:-1] & ok[1:] & (step <= params.jump_m + 2e-2 * params.step_cm)
         a, b = _longest_run(joined)  # points a..b: every link between them joined
@@ -209,6 +223,21 @@ def suggest_pair(piece: Piece, surface: Surface, params: SuggestParams) -> tuple
     else:
         pat = _trim_to(pat, lb)
     return pat, surface.closest(body).points
+
+
+def _smaller_pairs(pieces: list[Piece], surface: Surface, params: SuggestParams) -> dict:
+    """Stroke pairs (`suggest_pair`) by piece name for pieces below the share rule, tried largest first, when no
+    piece above it reached the body: the share rule then holds among the pieces that do (GarmentCode lays a
+    dress's bodice on the body and its skirt panels, each eight times the bodice's pieces, far out)."""
+    out, first = {}, None
+    for piece in pieces:
+        if first is not None and piece.area < params.min_area_share * first:
+            break
+        got = suggest_pair(piece, surface, params)
+        if got is not None:
+            out[piece.name] = got
+            first = piece.area if first is None else first
+    return out
 
 
 def suggest_strokes(
@@ -235,12 +264,23 @@ def suggest_strokes(
         )
     mesh = body if isinstance(body, TriMesh) else body.mesh
     surf = surface if surface is not None else Surface(mesh)
-    largest = max(pc.area for pc in placed)
+    by_size = sorted(placed, key=lambda pc: -pc.area)
+    big = [pc for pc in by_size if pc.area >= p.min_area_share * by_size[0].area]
+    found = {pc.name: suggest_pair(pc, surf, p) for pc in big}
+    if not any(found.values()):
+        found.update(_smaller_pairs(by_size[len(big) :], surf, p))
+    missed = [pc.name for pc in big if found[pc.name] is None]
+    if missed:
+        # A piece drawn in from far (a skirt panel) lies on the body from where it is sewn (the waist) down to
+        # where it touches it (the hips), and hangs free below: its whole line is tried, and only that part kept.
+        drawn = replace(p, trim=0.0, reach_m=min(p.reach_m, p.drawn_in_reach_m))
+        for name, (moved, touch_y) in drawn_in_placements(pattern, missed, surf, p.reach_m).items():
+            piece = pattern.piece(name).copy()
+            piece.placement = moved
+            found[name] = suggest_pair(piece, surf, drawn, lowest_m=touch_y - p.drawn_in_below_m)
     pairs: list[StrokePair] = []
-    for piece in sorted(placed, key=lambda pc: -pc.area):
-        if piece.area < p.min_area_share * largest:
-            continue
-        got = suggest_pair(piece, surf, p)
+    for piece in by_size:
+        got = found.get(piece.name)
         if got is None:
             continue
         pat, on = got
