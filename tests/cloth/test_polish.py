@@ -219,6 +219,28 @@ def test_compressed_cloth_on_a_floor_buckles_up_instead_of_staying_compressed():
     assert stats.folded == folded_faces(model, state).sum()
 
 
+def test_strain_limit_takes_stretch_out_or_leaves_the_cloth_as_it_was():
+    """cap_strain pulls the few edges strained past the limit back to it; where the limit cannot win (a strip
+    stretched 15 % between pinned ends: the sweeps can only move the strain about, raising its max), it leaves the
+    cloth exactly as it found it and says so."""
+    from kitsuke.cloth._polish import cap_strain
+
+    model, rest = flat_sheet(11, 6, 0.02)
+    lifted = rest + [0.0, 0.0, 0.003]
+    bumped = lifted.copy()
+    bumped[27] += [0.004, 0.003, 0.0]  # an inner vertex pulled 5 mm: its edges 20-30 % long
+    state = ClothState.new(model, bumped)
+    assert strain(bumped, model.edges, model.rest_lengths).max > 0.2
+    assert cap_strain(model, state, floor_collider(), 0.045, sweeps=400)
+    assert strain(state.positions, model.edges, model.rest_lengths).max < 0.046
+
+    pulled = rest * [1.15, 1.0, 0.0] + [0.0, 0.0, 0.003]
+    ends = (rest[:, 0] < 1e-9) | (rest[:, 0] > rest[:, 0].max() - 1e-9)
+    state = ClothState.new(model, pulled, pinned=ends)
+    assert not cap_strain(model, state, floor_collider(), 0.045, sweeps=400)
+    np.testing.assert_array_equal(state.positions, pulled)
+
+
 def test_bad_arguments_are_rejected():
     model, rest = flat_sheet(4, 4, 0.02)
     state = ClothState.new(model, rest)

@@ -402,6 +402,11 @@ class Contacts:
         self.distance[:] = np.inf
         self.anchor_distance[:] = np.inf
 
+    def assign(self, other: Contacts) -> None:
+        """Take `other`'s tracked points (in place, so that states sharing these contacts see them)."""
+        for f in fields(self):
+            getattr(self, f.name)[...] = getattr(other, f.name)
+
     def touching(self, contact_distance_m: float) -> np.ndarray:
         """(V,) bool: tracked and closer to the body than `contact_distance_m`."""
         return (self.face >= 0) & (self.distance < contact_distance_m)

@@ -78,6 +78,11 @@ LOCAL_RINGS = 3
 #: farther than LIMIT_TOLERANCE_M (metres: rounding) beyond the limit.
 LIMIT_COLLIDE_EVERY = 8
 LIMIT_TOLERANCE_M = 1e-7
+#: A strain limit (`cap_strain`) is undone when it leaves the max edge strain more than this above what it was, or
+#: the mean more than LIMIT_KEEP_MEAN above (a fifth of the 1 % mean target): it made the cloth worse. On the
+#: shipped cases it never does (it takes the shirt's max 10.5 -> 5.0 % for +0.09 points of mean strain).
+LIMIT_KEEP_MAX = 0.005
+LIMIT_KEEP_MEAN = 0.002
 #: Most strain-limit sweeps after each polish but the last (`polish_refined`).
 LIMIT_SWEEPS_BETWEEN = 400
 
@@ -208,11 +213,19 @@ def cap_strain(
     *,
     sweeps: int = 1000,
     tethers: Tethers | None = None,
-) -> None:
+) -> bool:
     """Pull every edge strained more than `limit` back to it, leaving the others alone (in place): up to `sweeps`
     Gauss-Seidel sweeps of `restore_lengths` with that band, the body searched afresh before the first (so the
     sweeps correct what the search's push does), collision every LIMIT_COLLIDE_EVERY sweeps, the tethers held;
-    they stop once nothing is farther than LIMIT_TOLERANCE_M beyond the band."""
+    they stop once nothing is farther than LIMIT_TOLERANCE_M beyond the band.
+
+    Where the body will not let the limit have its way (cloth pinched between an arm and the torso, pushed back by
+    the collision after every few sweeps), the sweeps spread the strain instead of removing it: on a GarmentCode
+    top, max strain 29 -> 43 % and mean 0.93 -> 1.36 % in one call. Such a result is undone: the cloth goes back to
+    where it was unless its max strain is no more than LIMIT_KEEP_MAX above what it was and its mean strain no more
+    than LIMIT_KEEP_MEAN above. Returns whether the limited cloth was kept."""
+    max0, mean0 = _strain_max_mean(model, state.positions)
+    saved = state.copy()
     restore_lengths(
         model,
         state,
@@ -224,6 +237,19 @@ def cap_strain(
         tolerance_m=LIMIT_TOLERANCE_M,
         search_first=True,
     )
+    max1, mean1 = _strain_max_mean(model, state.positions)
+    if max1 <= max0 + LIMIT_KEEP_MAX and mean1 <= mean0 + LIMIT_KEEP_MEAN:
+        return True
+    state.positions[:] = saved.positions
+    state.contacts.assign(saved.contacts)
+    return False
+
+
+def _strain_max_mean(model: ClothModel, positions: np.ndarray) -> tuple[float, float]:
+    """The largest and the mean edge strain |length / rest − 1| of the cloth at `positions`."""
+    e = model.edges
+    r = np.abs(np.linalg.norm(positions[e[:, 0]] - positions[e[:, 1]], axis=1) / model.rest_lengths - 1.0)
+    return (float(r.max()), float(r.mean())) if len(r) else (0.0, 0.0)
 
 
 @dataclass
