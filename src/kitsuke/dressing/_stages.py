@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -47,17 +47,12 @@ def check_finite(state: ClothState, stage: str) -> None:
 
 @dataclass
 class StageLog:
-    """What a pipeline's stages did: seconds per stage name (summed over repeats) and each stage's last stats.
-    `say` is called with a stage's name as it starts (a progress display)."""
+    """A pipeline's record: the operation's name (for errors), `say` called with a stage's name as it starts (a
+    progress display), and seconds per stage (or per `timing` key), summed over repeats."""
 
     operation: str
     say: Callable[[str], None] = lambda _name: None
-    timings: dict[str, float] | None = None
-    stats: dict[str, dict] | None = None
-
-    def __post_init__(self) -> None:
-        self.timings = {} if self.timings is None else self.timings
-        self.stats = {} if self.stats is None else self.stats
+    timings: dict[str, float] = field(default_factory=dict)
 
 
 def run_stage(
@@ -82,7 +77,6 @@ def run_stage(
         state.positions = view.positions
     key = timing or name
     log.timings[key] = log.timings.get(key, 0.0) + time.perf_counter() - t0
-    log.stats[name] = out
     check_finite(state, f"{log.operation}: {name}")
     return out
 
