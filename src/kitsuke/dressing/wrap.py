@@ -315,10 +315,9 @@ def wrap(
 
     # Step 2: the seed faces' vertices are placed; faces whose three vertices are placed join at once.
     growing = Growing(p.grow, hang, placement.placed.copy())
-    rings = run_stage(
+    grown = run_stage(
         log, "growing the cloth", grow_stage, model, state, shaping, growing, pinned=seed_pins, timing="grow"
     )
-    rings = rings["rings"]
     if not state.face_active.all():
         missing = np.flatnonzero(~state.face_active)
         piece_of = np.searchsorted(welded.piece_faces[:, 1], missing, side="right")
@@ -400,7 +399,7 @@ def wrap(
         )
         log.say("polishing")
         t_polish = time.perf_counter()
-        done = _polish_passes(settle, state, collider, p, welded, placement.tracks, tethers, loose, unheld, pins)
+        done = _polish_passes(settle, state, collider, p, welded, placement.tracks, tethers, loose, unheld)
         check_finite(done.state, "wrap: polish")
         timings["polish"] = timings.get("polish", 0.0) + time.perf_counter() - t_polish
         return done
@@ -439,7 +438,7 @@ def wrap(
         stroke_length_ratio=ratio,
         tracks=tracks,
         loose_strokes=[tr.id for tr, far in zip(placement.tracks, loose, strict=True) if far],
-        rings=rings,
+        rings=grown["rings"],
         polished=done.polished,
         mend=mended,
         timings=timings,
@@ -492,7 +491,6 @@ def _polish_passes(
     tethers: Tethers | None,
     loose: np.ndarray,
     unheld: np.ndarray,
-    pins: np.ndarray,
 ) -> _Finished:
     """Step 7: up to `polish.passes` polishes (`_polish_step`; a later one only while the max strain is over
     MAX_STRAIN_TARGET: it starts from the better cloth and takes another path to the buckles), each kept only where
