@@ -189,6 +189,7 @@ def drag_front(garment, body) -> dict:
     body by each of DRAGS and release; freely and with the back pinned. Within targets: the corpus ones."""
     from kitsuke.dressing import DragSession
     from kitsuke.errors import ComputationError, InputError
+    from kitsuke.metrics import QualityTargets
 
     p = garment.positions
     mid = np.median(p[:, 1])
@@ -209,8 +210,8 @@ def drag_front(garment, body) -> dict:
             except (ComputationError, InputError) as e:
                 out[name] = f"failed: {str(e)[:80]}"
                 continue
-            ok = r.strain_max <= 0.10 and r.strain_mean <= 0.01 and r.penetration_count == 0 and r.inverted_count == 0
-            out[name] = "ok" if ok else f"out of target ({100 * r.strain_max:.0f} % max)"
+            misses = r.failures(QualityTargets.robust())
+            out[name] = "ok" if not misses else f"out of target ({misses[0][:60]})"
             out[name + "_seconds"] = time.perf_counter() - t0
     return out
 
