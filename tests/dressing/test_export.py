@@ -86,6 +86,10 @@ def test_dress_bad_input_is_exit_2_and_writes_nothing(run_cli, tmp_path):
         (["--strokes", str(SHIRT_STROKES), "--stroke-reach", "-1"], "--stroke-reach must be between 0 and 100 mm"),
         (["--strokes", str(SHIRT_STROKES), "--hang", "-1"], "--hang must be between 0 and 10"),
         (["--strokes", str(SHIRT_STROKES), "--hang", "nan"], "--hang must be between 0 and 10"),
+        (["--strokes", str(SHIRT_STROKES), "--set", "polish.roundz=0"], "no wrap setting 'polish.roundz'"),
+        (["--strokes", str(SHIRT_STROKES), "--set", "polish"], "NAME=VALUE"),
+        (["--strokes", str(SHIRT_STROKES), "--set", "settle.method=verlet"], "SettleSettings.method"),
+        (["--strokes", str(SHIRT_STROKES), "--set", "polish.rounds=abc"], "polish.rounds takes a number"),
     ]
     for extra, needle in cases:
         r = run_cli("dress", "--body", MEAN_ALL, "--pattern", SHIRT, "-o", out, *extra)
@@ -102,6 +106,10 @@ def test_dress_bad_input_is_exit_2_and_writes_nothing(run_cli, tmp_path):
     assert r.code == 2 and "--stroke-reach is for a wrap" in r.err and not out.exists()
     r = run_cli("dress", "--body", MEAN_ALL, "--garment", SHIRT, "--strokes", SHIRT_STROKES, "-o", out, "--hang", "2")
     assert r.code == 2 and "--hang is for a wrap" in r.err and not out.exists()
+    r = run_cli(
+        "dress", "--body", MEAN_ALL, "--garment", SHIRT, "--strokes", SHIRT_STROKES, "-o", out, "--set", "grow.hang=1"
+    )
+    assert r.code == 2 and "--set changes the wrap's settings" in r.err and not out.exists()
 
 
 def test_dress_without_the_polish(run_cli, tmp_path, dressed):
@@ -118,6 +126,14 @@ def test_dress_without_the_polish(run_cli, tmp_path, dressed):
     assert quick["faces"] < full["faces"]
     assert quick["quality"]["strain_max"] > 0.05 >= full["quality"]["strain_max"]
     assert "targets missed: max edge strain" in r.err and "all quality targets met" not in r.err
+    # The same by the setting's name: the same garment.
+    same = tmp_path / "same.json"
+    r = run_cli(
+        "dress", "--body", MEAN_ALL, "--pattern", SHIRT, "--strokes", SHIRT_STROKES, "-o", tmp_path / "same.glb",
+        "--report", same, "--set", "polish.rounds=0",
+    )  # fmt: skip
+    assert r.code == 0, r.err
+    assert json.loads(same.read_text())["quality"] == quick["quality"]
 
 
 def test_dress_a_kimono_pattern_like_the_demo(run_cli, tmp_path):

@@ -108,6 +108,16 @@ def register(parser: argparse.ArgumentParser) -> None:
         "re-wrap's without refinement): about twice as fast (GarmentCode's shirt: 1.0 instead of 1.8 s of wrap) "
         "but the max edge strain stays where the settle left it (the shirt: 28 %% instead of 4.5 %%)",
     )
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        dest="settings",
+        help="change one of the wrap's settings by its dotted name, applied after the options above (repeatable; "
+        "e.g. --set settle.method=global --set polish.passes=1 --set grow.hang=1.5); the groups are grow, close, "
+        "settle, lengths, tethers, untangle and polish (kitsuke.dressing.WrapParams)",
+    )
     add_body_options(parser)
     parser.set_defaults(run=run)
 
@@ -116,7 +126,7 @@ def run(args: argparse.Namespace) -> int:
     from ..cloth import precompile_in_background
     from ..dressing import check_strokes, read_strokes, target_misses
     from ..dressing.export import write_garment_outputs
-    from ..dressing.options import DressOptions
+    from ..dressing.options import DressOptions, parse_setting
     from ..dressing.wrap import DressedGarment, wrap
     from ..errors import ComputationError, InputError
     from ..pattern import load_pattern
@@ -136,8 +146,9 @@ def run(args: argparse.Namespace) -> int:
         hold_strokes=args.hold_strokes,
         hang=args.hang,
         no_polish=args.no_polish,
+        settings=tuple(parse_setting(text) for text in args.settings),
     )
-    options.check(spell=lambda name: "--" + name.replace("_", "-"))
+    options.check(spell=lambda name: "--set" if name == "settings" else "--" + name.replace("_", "-"))
     if args.garment:
         if args.stroke_reach != 8.0:
             raise InputError("--stroke-reach is for a wrap: a re-wrap (--garment) holds its strokes already")
@@ -145,6 +156,8 @@ def run(args: argparse.Namespace) -> int:
             raise InputError("--hold-strokes is for a wrap: a re-wrap (--garment) holds its strokes already")
         if args.hang is not None:
             raise InputError("--hang is for a wrap: a re-wrap (--garment) moves cloth already grown")
+        if args.settings:
+            raise InputError("--set changes the wrap's settings: a re-wrap (--garment) has its own")
         return _rewrap(args, outs)
     if args.pin:
         raise InputError("--pin holds part of a dressed garment: use it with --garment (a re-wrap)")

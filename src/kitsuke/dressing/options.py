@@ -4,6 +4,7 @@ with the same options is the same garment."""
 
 from __future__ import annotations
 
+import ast
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -20,6 +21,8 @@ class DressOptions:
     hold_strokes : keep the garment hanging from its strokes instead of letting it settle.
     hang : how strongly cloth growing off the body turns down (0-10), or None: 2 for a kimono, 0 otherwise.
     no_polish : skip the polish (faster; the max strain stays where the settle left it).
+    settings : any of the wrap's settings by dotted name, applied last (`WrapParams.changed`; `parse_setting`
+        reads "polish.rounds=0" as a user writes it).
     """
 
     edge_length: float = 1.5
@@ -27,6 +30,7 @@ class DressOptions:
     hold_strokes: bool = False
     hang: float | None = None
     no_polish: bool = False
+    settings: tuple[tuple[str, object], ...] = ()
 
     def check(self, spell: Callable[[str], str] = lambda name: name) -> None:
         """Raise InputError for a value out of its range; `spell` turns a field name into what the user wrote
@@ -37,6 +41,10 @@ class DressOptions:
             raise InputError(f"{spell('stroke_reach')} must be between 0 and 100 mm, got {self.stroke_reach}")
         if self.hang is not None and not 0 <= self.hang <= 10:
             raise InputError(f"{spell('hang')} must be between 0 and 10, got {self.hang}")
+        try:
+            WrapParams().changed(dict(self.settings))
+        except (InputError, TypeError) as e:
+            raise InputError(f"{spell('settings')}: {e}") from None
 
     def wrap_params(self, body, pattern) -> WrapParams:
         """The WrapParams of these options for `pattern` on `body` (a kimono gets its hang, offset and obi band)."""
@@ -51,4 +59,16 @@ class DressOptions:
             params = params.changed({"polish.rounds": 0})
         if is_kimono(pattern):
             params = kimono_params(body, params, hang=self.hang)
-        return params
+        return params.changed(dict(self.settings))
+
+
+def parse_setting(text: str) -> tuple[str, object]:
+    """("polish.rounds", 0) from "polish.rounds=0": the value read as a Python literal (numbers, True, None,
+    tuples), else kept as text ("settle.method=global"). InputError without a '='."""
+    name, sep, value = text.partition("=")
+    if not sep or not name.strip():
+        raise InputError(f"a wrap setting is NAME=VALUE (e.g. polish.rounds=0), got {text!r}")
+    try:
+        return name.strip(), ast.literal_eval(value.strip())
+    except (ValueError, SyntaxError):
+        return name.strip(), value.strip()

@@ -277,6 +277,8 @@ class WrapParams:
             if not dataclasses.is_dataclass(current) or key not in {f.name for f in fields(current)}:
                 known = ", ".join(f.name for f in fields(current)) if dataclasses.is_dataclass(current) else ""
                 raise InputError(f"no wrap setting {name!r}" + (f": {group} has {known}" if known else ""))
+            if isinstance(value, str) and not isinstance(getattr(current, key), str):
+                raise InputError(f"wrap setting {name} takes a number, True/False, None or a tuple, got {value!r}")
             out = dataclasses.replace(out, **{group: dataclasses.replace(current, **{key: value})})
         return out
 
