@@ -56,6 +56,23 @@ def test_json_with_defaults(tmp_path):
     assert read_manifest(_json(tmp_path, [{"id": "c", "body": "x", "pattern": "p", "strokes": "s"}]))[0].id == "c"
 
 
+def test_wrap_settings_column(tmp_path):
+    """`set`: any wrap setting by dotted name, as `kitsuke dress --set`, in CSV text or a JSON object; the job's
+    wrap takes it."""
+    from kitsuke.body import default_body
+    from kitsuke.pattern import default_kimono
+
+    csv = tmp_path / "jobs.csv"
+    csv.write_text("id,body,pattern,strokes,set\na,default,p.json,s.json,polish.rounds=0; settle.method=global\n")
+    (job,) = read_manifest(csv)
+    assert job.options.settings == (("polish.rounds", 0), ("settle.method", "global"))
+    row = {**ROW, "set": {"grow.hang": 1.5, "tethers.reach_m": None}}
+    (other,) = read_manifest(_json(tmp_path, [row]))
+    params = other.options.wrap_params(default_body(), default_kimono())
+    assert params.grow.hang == 1.5 and params.tethers.reach_m is None
+    assert job.options.wrap_params(default_body(), default_kimono()).polish.rounds == 0
+
+
 def _json(tmp_path, rows):
     p = tmp_path / "list.json"
     p.write_text(json.dumps(rows))
@@ -80,6 +97,8 @@ ROW = {"id": "a", "body": "default", "pattern": "p.json", "strokes": "suggest"}
         ({"strokes": "s.json", "min_area": "0.2"}, "line 2: min_area is for suggested strokes"),
         ({"targets": "loose"}, "targets must be one of standard, robust"),
         ({"perturb": "1.5"}, "line 2: perturb must be a seed, an integer >= 0, got '1.5'"),
+        ({"set": "polish.roundz=0"}, "line 2: set: no wrap setting 'polish.roundz'"),
+        ({"set": "polish"}, "line 2: a wrap setting is NAME=VALUE"),
     ],
 )
 def test_bad_csv_refused_naming_file_and_row(tmp_path, change, message):

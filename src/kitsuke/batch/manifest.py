@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from .._files import read_json, require_file
-from ..dressing.options import DressOptions
+from ..dressing.options import DressOptions, parse_setting
 from ..errors import InputError
 
 #: A job id names its output folder: letters, digits, `.`, `_`, `-`, not starting with a dot (no hidden folders,
@@ -50,6 +50,8 @@ COLUMNS: dict[str, str] = {
     "hold_strokes": "hang the garment from its strokes (default false)",
     "hang": "how strongly cloth off the body turns down (default: 2 for a kimono, else 0)",
     "no_polish": "skip the polish: faster, more strain (default false)",
+    "set": "other wrap settings by dotted name, NAME=VALUE separated by ';' (e.g. polish.rounds=0;settle.method="
+    "global; in JSON also an object), as `kitsuke dress --set`",
     "min_area": "suggest only: smallest piece given a stroke, share of the largest (default 0.15)",
     "perturb": "draw the strokes as another hand would (kitsuke.dressing.perturb_strokes), this seed",
     "units": "body file's length unit: " + ", ".join(UNITS) + " (default auto)",
@@ -246,8 +248,9 @@ def _job(row: dict[str, Any], folder: Path, where: str) -> Job:
         hold_strokes=_bool(row, "hold_strokes", False),
         hang=_number(row, "hang", None),
         no_polish=_bool(row, "no_polish", False),
+        settings=_settings(row),
     )
-    options.check()
+    options.check(spell=lambda name: "set" if name == "settings" else name)
     min_area = _number(row, "min_area", None)
     if min_area is not None:
         if strokes != SUGGEST:
@@ -279,6 +282,18 @@ def _job(row: dict[str, Any], folder: Path, where: str) -> Job:
         png=_bool(row, "png", False),
         where=where,
     )
+
+
+def _settings(row: dict[str, Any]) -> tuple[tuple[str, Any], ...]:
+    """The `set` column: "NAME=VALUE;NAME=VALUE" (`parse_setting`), or in JSON an object {name: value}."""
+    value = row.get("set")
+    if value is None or value == "":
+        return ()
+    if isinstance(value, dict):
+        return tuple(value.items())
+    if isinstance(value, str):
+        return tuple(parse_setting(part) for part in value.split(";") if part.strip())
+    raise InputError(f"set must be NAME=VALUE;... or an object of settings, got {value!r}")
 
 
 def _path(folder: Path, value: str) -> str:
