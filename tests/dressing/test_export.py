@@ -89,7 +89,9 @@ def test_dress_bad_input_is_exit_2_and_writes_nothing(run_cli, tmp_path):
         (["--strokes", str(SHIRT_STROKES), "--set", "polish.roundz=0"], "no wrap setting 'polish.roundz'"),
         (["--strokes", str(SHIRT_STROKES), "--set", "polish"], "NAME=VALUE"),
         (["--strokes", str(SHIRT_STROKES), "--set", "settle.method=verlet"], "SettleSettings.method"),
-        (["--strokes", str(SHIRT_STROKES), "--set", "polish.rounds=abc"], "polish.rounds takes a number"),
+        (["--strokes", str(SHIRT_STROKES), "--set", "polish.rounds=abc"], "polish.rounds takes a whole number"),
+        (["--strokes", str(SHIRT_STROKES), "--set", "polish.rounds=2.5"], "polish.rounds takes a whole number"),
+        (["--strokes", str(SHIRT_STROKES), "--set", "settle.release_strokes=1"], "takes True or False"),
     ]
     for extra, needle in cases:
         r = run_cli("dress", "--body", MEAN_ALL, "--pattern", SHIRT, "-o", out, *extra)

@@ -447,6 +447,9 @@ def test_wrap_rejects_a_missing_piece_and_bad_params():
         "untangle.bend": -0.1,
         "lengths.collide_every": 0,
         "grow.hang_clearance_m": -0.01,
+        "grow.bridge_legs": "yes",
+        "polish.passes": 1.5,
+        "settle.release_strokes": 0,
     }
     bad_settings |= {f"lengths.over_relaxation={v}": v for v in (0.5, 2.0, float("nan"))}
     bad_settings |= {f"lengths.chebyshev_rho={v}": v for v in (0.0, 1.0, float("nan"))}

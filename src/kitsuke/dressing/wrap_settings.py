@@ -25,6 +25,30 @@ def _at_least(group: object, minimum: int, *names: str) -> None:
             raise InputError(f"{type(group).__name__}.{name} must be >= {minimum}")
 
 
+def _of_kind(name: str, default: object, value: object) -> object:
+    """`value` for the setting `name` whose default is `default`, of the default's kind (an int given for a float
+    becomes one); InputError otherwise. None and settings whose default is None or a settings group pass as they
+    are: their own checks judge them."""
+    if value is None or default is None or dataclasses.is_dataclass(default):
+        return value
+    if isinstance(default, bool):
+        ok = isinstance(value, bool)
+        kind = "True or False"
+    elif isinstance(default, int):
+        ok = isinstance(value, int) and not isinstance(value, bool)
+        kind = "a whole number"
+    elif isinstance(default, float):
+        ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+        value = float(value) if ok else value
+        kind = "a number"
+    else:
+        ok = isinstance(value, type(default))
+        kind = f"a {type(default).__name__}"
+    if not ok:
+        raise InputError(f"wrap setting {name} takes {kind}, got {value!r}")
+    return value
+
+
 @dataclass(frozen=True)
 class GrowSettings:
     """Steps 1-2, placing the stroke triangles and growing the rest of the garment from them.
@@ -61,6 +85,8 @@ class GrowSettings:
             raise InputError("GrowSettings.lift_m and GrowSettings.hang_clearance_m must be >= 0 (metres)")
         if not (np.isfinite(self.hang) and self.hang >= 0 and np.isfinite(self.skirt_hang) and self.skirt_hang >= 0):
             raise InputError("GrowSettings.hang and GrowSettings.skirt_hang must be finite and >= 0")
+        if self.bridge_legs not in (None, True, False):
+            raise InputError(f"GrowSettings.bridge_legs must be None, True or False, got {self.bridge_legs!r}")
 
 
 @dataclass(frozen=True)
@@ -263,22 +289,22 @@ class WrapParams:
 
     def changed(self, values: dict[str, object]) -> WrapParams:
         """A copy with settings changed by dotted name: {"polish.rounds": 0, "edge_length_cm": 2.0}. Raises
-        InputError for a name that is no setting."""
+        InputError for a name that is no setting, or a value of another kind than the setting's (a whole number
+        for a count, a number for a quantity, True/False for a switch; None where the setting allows it)."""
         out = self
+        names = {f.name for f in fields(self)}
         for name, value in values.items():
             group, _, key = name.partition(".")
-            names = {f.name for f in fields(self)}
             if group not in names:
                 raise InputError(f"no wrap setting {name!r}: the groups are {', '.join(sorted(names))}")
             if not key:
-                out = dataclasses.replace(out, **{group: value})
+                out = dataclasses.replace(out, **{group: _of_kind(name, getattr(out, group), value)})
                 continue
             current = getattr(out, group)
             if not dataclasses.is_dataclass(current) or key not in {f.name for f in fields(current)}:
                 known = ", ".join(f.name for f in fields(current)) if dataclasses.is_dataclass(current) else ""
                 raise InputError(f"no wrap setting {name!r}" + (f": {group} has {known}" if known else ""))
-            if isinstance(value, str) and not isinstance(getattr(current, key), str):
-                raise InputError(f"wrap setting {name} takes a number, True/False, None or a tuple, got {value!r}")
+            value = _of_kind(name, getattr(current, key), value)
             out = dataclasses.replace(out, **{group: dataclasses.replace(current, **{key: value})})
         return out
 
