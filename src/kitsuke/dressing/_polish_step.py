@@ -27,12 +27,12 @@ from ..cloth import (
 )
 from ..cloth._polish import cap_strain
 from ..errors import InputError
-from ..metrics import layer_crossing_mm, strain
+from ..metrics import QualityTargets, layer_crossing_mm, strain
 
-#: What the polish must not make worse than this, if it was better (issue 3's targets: mean strain 1 %, stroke
-#: residual 1 cm).
-POLISH_MEAN_STRAIN = 0.01
-POLISH_RESIDUAL_M = 0.01
+#: What the polish must not make worse than this, if it was better: the quality targets' mean strain and stroke
+#: residual (metres).
+POLISH_MEAN_STRAIN = QualityTargets().mean_strain
+POLISH_RESIDUAL_M = 1e-3 * QualityTargets().stroke_residual_mm
 
 
 @dataclass(frozen=True)

@@ -65,7 +65,7 @@ from ..body.legs import leg_gap
 from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, RefinedPolish, Tethers
 from ..errors import ComputationError, InputError
 from ..geometry import TriMesh
-from ..metrics import QualityReport, quality_report, strain
+from ..metrics import QualityReport, QualityTargets, quality_report, strain
 from ..pattern import Pattern, PatternMesh, face_layers, mesh_pattern
 from ._bridge import bridged, spans_legs
 from ._mend import MendStats, mend_tears
@@ -217,8 +217,8 @@ def _band_held(body, mesh: TriMesh, state: ClothState, band: tuple[float, float]
     return held
 
 
-#: Issue 3's max edge strain target: the polish runs another pass while the garment is over it.
-MAX_STRAIN_TARGET = 0.05
+#: The quality targets' max edge strain (QualityTargets): the polish runs another pass while the garment is over it.
+MAX_STRAIN_TARGET = QualityTargets().max_strain
 
 
 def wrap(
