@@ -137,7 +137,7 @@ def build_scene(frames: int) -> Scene:
         faces=np.asarray(g.faces, dtype=np.int64),
         edges=sim.model.edges,
         rest_pattern=np.asarray(sim.model.rest_lengths, dtype=np.float64),
-        rest_start=sim.data.stretch_rest.copy(),
+        rest_start=_in_model_order(sim.data.stretch_rest, sim.data.stretch_edge),
         mass=sim.data.mass.copy(),
         held=moving.hold.vertices.copy(),
         skin=np.asarray(skins),
@@ -151,6 +151,13 @@ def build_scene(frames: int) -> Scene:
         n_lead=n_lead,
         dt=1.0 / animation.fps,
     )
+
+
+def _in_model_order(values: np.ndarray, edge: np.ndarray) -> np.ndarray:
+    """Per-pair values of kitsuke's solver (in its sweeps' order) in the order of the model's edges."""
+    out = np.empty_like(values)
+    out[edge] = values
+    return out
 
 
 # --------------------------------------------------------------------------------------------------------------

@@ -278,3 +278,20 @@ def test_forget_finds_a_vertex_pushed_into_a_neighbouring_surface():
     collide(model, state, col)
     assert state.contacts.face[0] >= len(a.faces)
     assert penetration(state.positions[:1], two, threshold_m=0.0).count == 0
+
+
+def test_vertex_grid_finds_the_nearest_body_vertex(body, rng):
+    """The moving body's global search starts at the body vertex nearest each cloth vertex, found in a grid of
+    cells: the same vertex a pass over all of them finds, near the body and far from it (outside the grid too)."""
+    from kitsuke.cloth import _collide_kernels as K
+
+    v = np.ascontiguousarray(body.mesh.vertices, dtype=np.float64)
+    cell = 0.037
+    origin, dims, start, items = K.vertex_grid(v, cell)
+    assert sorted(items) == list(range(len(v))) and start[-1] == len(v)
+    near = v[rng.integers(0, len(v), 400)] + rng.normal(size=(400, 3)) * 0.05
+    far = rng.uniform(-2.0, 3.0, size=(100, 3))
+    for q in np.vstack([near, far]):
+        found = K._grid_nearest(q[0], q[1], q[2], v, origin, dims, cell, start, items)
+        d = np.linalg.norm(v - q, axis=1)
+        assert d[found] == d.min()

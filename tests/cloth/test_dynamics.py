@@ -90,7 +90,14 @@ def test_capsule_collision_matches_reference(rng):
     moved = rng.normal(size=ends.shape) * 0.003
     p_k = p.copy()
     K.collide_capsules(p_k, x, inv_mass, ends, radii, moved, 0.004, 0.4)
-    np.testing.assert_allclose(p_k, R.collide_capsules(p, x, inv_mass, ends, radii, moved, 0.004, 0.4), atol=1e-12)
+    expect = R.collide_capsules(p, x, inv_mass, ends, radii, moved, 0.004, 0.4)
+    np.testing.assert_allclose(p_k, expect, atol=1e-12)
+    # the same from the (vertex, capsule) pairs found near each other first
+    pairs, p_k = np.empty((60 * len(ends), 2), dtype=np.int64), p.copy()
+    n = K.capsule_candidates(p_k, inv_mass, ends, radii, 0.004 + 0.02, pairs)
+    assert 0 < n < 60 * len(ends)  # far pairs left out
+    K.collide_capsule_pairs(p_k, x, ends, radii, moved, 0.004, 0.4, pairs, n)
+    np.testing.assert_allclose(p_k, expect, atol=1e-12)
 
 
 # -- physics -----------------------------------------------------------------------------------------------------
@@ -279,3 +286,18 @@ def test_a_moved_body_has_the_normals_of_a_body_built_there():
     moved = collider.moved(posed.vertices)
     for name in ("face_normals", "edge_normals", "vertex_normals"):
         np.testing.assert_allclose(getattr(moved, name), getattr(built, name), atol=1e-12, rtol=0)
+
+
+def test_constraints_are_swept_colour_by_colour(rng):
+    """Consecutive constraints of a colour share no vertex (so the processor can overlap them), and the pairs keep
+    their rest lengths through the reordering."""
+    faces, corners, _ = grid_tube(12, 6, 0.02)
+    model = ClothModel.from_corners(faces, corners)
+    data = dynamics_data(model, DynamicsParams())
+    colour = K.colour_pairs(data.stretch_pairs, model.n_vertices)
+    assert (np.diff(colour) >= 0).all() and colour.max() < 12
+    for c in np.unique(colour):
+        ends = data.stretch_pairs[colour == c].ravel()
+        assert len(np.unique(ends)) == len(ends)
+    np.testing.assert_array_equal(data.stretch_pairs, model.edges[data.stretch_edge])
+    np.testing.assert_allclose(data.stretch_rest, model.rest_lengths[data.stretch_edge])

@@ -47,8 +47,8 @@ class BodyCollider:
     capsule_ends : (C, 2, 3) float64, metres; capsule_radii : (C, 2) float64, metres (tapered capsules).
     floor_y : height of the ground plane, metres, or None: cloth is kept above it (a long hem rests on the floor
         instead of hanging through it). `from_body` puts it under the feet.
-    moving : a pose of a moving body (made by `moved`): a few global searches walk from the nearest body vertex
-        instead of building a search tree for this pose alone.
+    moving : a pose of a moving body (made by `moved`): global searches walk from the nearest body vertex
+        (`vertex_grid`) instead of building a search tree for this pose alone.
     """
 
     vertices: np.ndarray
@@ -64,6 +64,7 @@ class BodyCollider:
     faces_at_ptr: np.ndarray = field(init=False, repr=False)
     faces_at: np.ndarray = field(init=False, repr=False)
     moving: bool = field(init=False, repr=False, default=False)
+    _grid: tuple | None = field(init=False, repr=False, default=None)
 
     @classmethod
     def from_mesh(
@@ -179,8 +180,19 @@ class BodyCollider:
         )
         out._set_capsule_box()
         out._surface = None
+        out._grid = None
         out.moving = True
         return out
+
+    def vertex_grid(self) -> tuple:
+        """The body's vertices binned in cubes of about one vertex each (`K.vertex_grid`: origin, dims, cell
+        size, start, items), built once per pose: a nearest-vertex query visits a few cells, not 13,000 vertices."""
+        if self._grid is None:
+            extent = np.maximum(self.vertices.max(axis=0) - self.vertices.min(axis=0), 1e-3)
+            cell = max(float(np.prod(extent) / max(len(self.vertices), 1)) ** (1.0 / 3.0), 1e-3)
+            origin, dims, start, items = K.vertex_grid(self.vertices, cell)
+            self._grid = (origin, dims, cell, start, items)
+        return self._grid
 
     @property
     def surface(self) -> Surface:
@@ -204,12 +216,6 @@ class BodyCollider:
     def nearest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Global nearest-surface query (`surface`): face (n,) int64, point (n, 3), distance (n,)."""
         return self.surface.nearest(points)
-
-
-#: On a moving body's pose (`BodyCollider.moved`), up to this many vertices needing a global search are found by
-#: a walk from their nearest body vertex instead of the search tree (a brute-force pass over the body's vertices,
-#: against ~17 ms to build the tree on a 13,000-vertex body every frame); more, and the tree is built.
-SEEDED_SEARCH_MAX = 1000
 
 
 @dataclass
@@ -280,7 +286,7 @@ def track(model: ClothModel, state: ClothState, collider: BodyCollider, *, activ
 
     Each vertex walks from its tracked body face to neighbouring faces while the nearest point gets closer; new
     vertices, failed walks and far vertices that may have come near the body get a global search: the AABB tree,
-    or, on a moving body's pose (few of them), a walk from the nearest body vertex (`SEEDED_SEARCH_MAX`).
+    or, on a moving body's pose, a walk from the nearest body vertex (the tree only where that walk fails).
     Returns the number of global searches.
     """
     if not isinstance(collider, BodyCollider):
@@ -291,7 +297,7 @@ def track(model: ClothModel, state: ClothState, collider: BodyCollider, *, activ
     _walk(model, state, collider, act, w["search"])
     idx = np.flatnonzero(w["search"])
     searched = len(idx)
-    if searched and collider.moving and collider._surface is None and searched <= SEEDED_SEARCH_MAX:
+    if searched and collider.moving and collider._surface is None:
         idx = _seeded_search(model, state, collider, idx, w)
     if len(idx):
         face, _, _ = collider.nearest(state.positions[idx])
@@ -322,13 +328,14 @@ def _store_found(state: ClothState, collider: BodyCollider, idx: np.ndarray, fac
 
 
 def _seeded_search(model: ClothModel, state: ClothState, collider: BodyCollider, idx: np.ndarray, w: dict):
-    """The global search for a few vertices on a body whose tree is not built (a moved body, every frame of a
-    simulation: building it cost 17 ms a frame, a third of the kimono's step): each vertex starts at the best face
-    around its nearest body vertex and walks to its nearest point. Returns the vertices whose walk failed (they get
-    the tree)."""
+    """The global search on a body whose tree is not built (a moved body, every frame of a simulation: building
+    it cost 17-22 ms a frame, a third of the kimono's step): each vertex starts at the best face around its nearest
+    body vertex (`BodyCollider.vertex_grid`) and walks to its nearest point. Returns the vertices whose walk failed
+    (they get the tree)."""
     face = np.empty(len(idx), dtype=np.int64)
+    origin, dims, cell, start, items = collider.vertex_grid()
     K.seed_faces(state.positions, idx, collider.vertices, collider.faces, collider.faces_at_ptr, collider.faces_at,
-                 face)  # fmt: skip
+                 origin, dims, cell, start, items, face)  # fmt: skip
     _store_found(state, collider, idx, face)
     only = np.zeros(len(state.positions), dtype=bool)
     only[idx] = True

@@ -287,20 +287,78 @@ def store_found(
         c_anchor_d[i] = sd
 
 
+@njit(cache=True)
+def vertex_grid(bv, cell):
+    """Bin the points bv (n, 3) into cubes of side `cell` metres (a counting sort): origin (3,), dims (3,) int64,
+    start (cells + 1,) int64, items (n,) int64; the points of cell (i, j, k) are items[start[c]:start[c + 1]] with
+    c = (i * dims[1] + j) * dims[2] + k."""
+    n = bv.shape[0]
+    origin = np.empty(3)
+    dims = np.empty(3, dtype=np.int64)
+    for a in range(3):
+        lo, hi = np.inf, -np.inf
+        for v in range(n):
+            lo = min(lo, bv[v, a])
+            hi = max(hi, bv[v, a])
+        origin[a] = lo
+        dims[a] = max(1, int((hi - lo) / cell) + 1)
+    n_cells = dims[0] * dims[1] * dims[2]
+    of = np.empty(n, dtype=np.int64)
+    start = np.zeros(n_cells + 1, dtype=np.int64)
+    for v in range(n):
+        c = 0
+        for a in range(3):
+            c = c * dims[a] + min(dims[a] - 1, int((bv[v, a] - origin[a]) / cell))
+        of[v] = c
+        start[c + 1] += 1
+    for c in range(n_cells):
+        start[c + 1] += start[c]
+    fill = start[:-1].copy()
+    items = np.empty(n, dtype=np.int64)
+    for v in range(n):
+        items[fill[of[v]]] = v
+        fill[of[v]] += 1
+    return origin, dims, start, items
+
+
+@njit(cache=True)
+def _grid_nearest(px, py, pz, bv, origin, dims, cell, start, items):
+    """The point of the grid (`vertex_grid`) nearest (px, py, pz): rings of cells outwards from the point's cell
+    (clamped into the grid) until no farther ring can hold a nearer point. Exact, as a pass over all points."""
+    q = (px, py, pz)
+    home = np.empty(3, dtype=np.int64)
+    for a in range(3):
+        home[a] = min(dims[a] - 1, max(0, int(math.floor((q[a] - origin[a]) / cell))))
+    best, bd2 = -1, np.inf
+    reach = max(dims[0], max(dims[1], dims[2]))
+    for r in range(reach + 1):
+        for i in range(max(0, home[0] - r), min(dims[0] - 1, home[0] + r) + 1):
+            for j in range(max(0, home[1] - r), min(dims[1] - 1, home[1] + r) + 1):
+                shell = abs(i - home[0]) == r or abs(j - home[1]) == r
+                for k in range(max(0, home[2] - r), min(dims[2] - 1, home[2] + r) + 1):
+                    if not shell and abs(k - home[2]) != r:
+                        continue  # inside the ring: seen in an earlier one
+                    c = (i * dims[1] + j) * dims[2] + k
+                    for m in range(start[c], start[c + 1]):
+                        v = items[m]
+                        d2 = (bv[v, 0] - px) ** 2 + (bv[v, 1] - py) ** 2 + (bv[v, 2] - pz) ** 2
+                        if d2 < bd2:
+                            best, bd2 = v, d2
+        # a point in ring r + 1 or beyond is at least r cells away from any point of the home cell
+        if best >= 0 and bd2 <= (r * cell) ** 2:
+            break
+    return best
+
+
 @njit(cache=True, parallel=PARALLEL)
-def seed_faces(pos, idx, bv, bf, vf_ptr, vf, out_face):
-    """For the vertices idx (n,): of the body faces around the body vertex nearest each (brute force over the
-    body's vertices), the one with the nearest point, in out_face (n,). A start for `walk_track`, which descends
-    from it to the nearest point."""
-    nb = bv.shape[0]
+def seed_faces(pos, idx, bv, bf, vf_ptr, vf, origin, dims, cell, start, items, out_face):
+    """For the vertices idx (n,): of the body faces around the body vertex nearest each (found in the body's
+    vertex grid, `vertex_grid`), the one with the nearest point, in out_face (n,). A start for `walk_track`, which
+    descends from it to the nearest point."""
     for j in prange(idx.shape[0]):
         i = idx[j]
         px, py, pz = pos[i, 0], pos[i, 1], pos[i, 2]
-        best, bd2 = 0, np.inf
-        for v in range(nb):
-            d2 = (bv[v, 0] - px) ** 2 + (bv[v, 1] - py) ** 2 + (bv[v, 2] - pz) ** 2
-            if d2 < bd2:
-                best, bd2 = v, d2
+        best = _grid_nearest(px, py, pz, bv, origin, dims, cell, start, items)
         face, fd2 = 0, np.inf
         for k in range(vf_ptr[best], vf_ptr[best + 1]):
             g = vf[k]

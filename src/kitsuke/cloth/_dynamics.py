@@ -33,6 +33,11 @@ from . import _dynamics_kernels as K
 from ._collide import BodyCollider, collide, track
 from ._model import ClothModel, ClothState
 
+#: Within a substep, the collision's rounds test only the (cloth vertex, capsule) pairs closer than this many
+#: metres (plus the offset) at the substep's start (`K.capsule_candidates`): a round moves cloth millimetres, and
+#: testing every vertex against every capsule in every round was a seventh of the kimono's step.
+CAPSULE_REACH_M = 0.02
+
 
 @dataclass(frozen=True)
 class DynamicsParams:
@@ -239,13 +244,15 @@ class MovingBody:
 
 @dataclass
 class DynamicsData:
-    """What the solver precomputes from a model: lumped masses and the constraint pairs with their rest lengths."""
+    """What the solver precomputes from a model: lumped masses and the constraint pairs with their rest lengths,
+    in the order the sweeps take them (colour by colour: `K.colour_pairs`)."""
 
     mass: np.ndarray  # (V,) kg
     stretch_pairs: np.ndarray  # (E, 2) int64
     stretch_rest: np.ndarray  # (E,) m
     bend_pairs: np.ndarray  # (H, 2) int64
     bend_rest: np.ndarray  # (H,) m
+    stretch_edge: np.ndarray  # (E,) int64: the model's edge of each stretch pair
 
 
 def dynamics_data(model: ClothModel, params: DynamicsParams, start: np.ndarray | None = None) -> DynamicsData:
@@ -275,13 +282,21 @@ def dynamics_data(model: ClothModel, params: DynamicsParams, start: np.ndarray |
         now = np.linalg.norm(start[model.edges[:, 1]] - start[model.edges[:, 0]], axis=1)
         rest = np.maximum(np.minimum(rest, now), now / (1.0 + params.max_strain))
         bend_rest = np.linalg.norm(start[hinge[:, 1]] - start[hinge[:, 0]], axis=1)
+    stretch = _by_colour(np.ascontiguousarray(model.edges, dtype=np.int64), model.n_vertices)
+    bend = _by_colour(np.ascontiguousarray(hinge, dtype=np.int64), model.n_vertices)
     return DynamicsData(
         mass,
-        np.ascontiguousarray(model.edges, dtype=np.int64),
-        rest,
-        np.ascontiguousarray(hinge, dtype=np.int64),
-        bend_rest,
+        np.ascontiguousarray(model.edges[stretch]),
+        np.ascontiguousarray(rest[stretch]),
+        np.ascontiguousarray(hinge[bend]),
+        np.ascontiguousarray(bend_rest[bend]),
+        stretch.astype(np.int64),
     )
+
+
+def _by_colour(pairs: np.ndarray, n_vertices: int) -> np.ndarray:
+    """The order (K,) that sweeps the pairs colour by colour (`K.colour_pairs`), each colour in its own order."""
+    return np.argsort(K.colour_pairs(pairs, n_vertices), kind="stable")
 
 
 def _corner(model: ClothModel, face: int, vertex: int) -> np.ndarray:
@@ -386,6 +401,8 @@ def step(
     keep = max(0.0, 1.0 - params.damping * h)
     planes = _skin_planes(model, state, body) if body is not None and body.surface is not None else None
     p = np.empty_like(x)
+    capsules = body is not None and len(body.ends) > 0
+    pairs = np.empty((len(x) * len(body.ends) if capsules else 0, 2), dtype=np.int64)
     lam_s = np.zeros(len(data.stretch_rest))
     lam_b = np.zeros(len(data.bend_rest))
     for s in range(n_sub):
@@ -401,19 +418,22 @@ def step(
         bend = params.bend_compliance / h**2
         K.solve_distances(p, inv_mass, data.bend_pairs, data.bend_rest, bend, bend, lam_b)
         t0, t1 = s / n_sub, (s + 1) / n_sub
+        if capsules:  # what is fixed over the substep, once
+            ends = (1.0 - t1) * body.previous + t1 * body.ends
+            moved = (t1 - t0) * (body.ends - body.previous)
+            reach = params.contact_offset_m + CAPSULE_REACH_M
+            n_pairs = K.capsule_candidates(p, inv_mass, ends, body.radii, reach, pairs)
+        if planes is not None:
+            index, plane_start, plane_end, normals = planes
+            points = (1.0 - t1) * plane_start + t1 * plane_end
+            plane_moved = (t1 - t0) * (plane_end - plane_start)
         for _ in range(int(params.contact_rounds)):
-            if body is not None and len(body.ends):
-                ends = (1.0 - t1) * body.previous + t1 * body.ends
-                moved = (t1 - t0) * (body.ends - body.previous)
-                K.collide_capsules(p, x, inv_mass, ends, body.radii, moved, params.contact_offset_m, params.friction)
+            if capsules:
+                K.collide_capsule_pairs(p, x, ends, body.radii, moved, params.contact_offset_m, params.friction, pairs,
+                                        n_pairs)  # fmt: skip
             if planes is not None:
-                index, plane_start, plane_end, normals = planes
-                points = (1.0 - t1) * plane_start + t1 * plane_end
-                K.collide_planes(
-                    p, x, inv_mass, index, points, normals, (t1 - t0) * (plane_end - plane_start),
-                    model.params.contact_offset_m,
-                    params.friction,
-                )  # fmt: skip
+                K.collide_planes(p, x, inv_mass, index, points, normals, plane_moved, model.params.contact_offset_m,
+                                 params.friction)  # fmt: skip
             K.limit_strain(p, inv_mass, data.stretch_pairs, data.stretch_rest, params.max_strain, params.max_squeeze)
         if body is not None and body.surface is not None and s == n_sub - 1:
             before = p.copy()
