@@ -708,10 +708,14 @@ def set_parallel(parallel: bool) -> None:
 def surface_normals(v, f, adj, face_n, edge_n, vert_n):
     """A closed surface's normals, into face_n (F, 3), edge_n (F, 3, 3) and vert_n (V, 3) (`BodyCollider`'s: unit
     face normals, each edge's mean of its two faces' normals, angle-weighted vertex normals); v (V, 3), f (F, 3),
-    adj (F, 3) the face across each edge: `BodyCollider.moved` recomputes them every frame of a simulation. The
-    same arithmetic as `BodyCollider._set_normals` (numpy), summed in the same order; vertex normals agree to
-    2e-16 (numpy's arccos rounds its own way)."""
+    adj (F, 3) the face across each edge: `BodyCollider.moved` recomputes them every frame of a simulation, in one
+    pass over the faces (the numpy `_set_normals`'s arithmetic, summed face by face: vertex normals agree to
+    1e-15)."""
     nv = v.shape[0]
+    for i in range(nv):
+        vert_n[i, 0] = 0.0
+        vert_n[i, 1] = 0.0
+        vert_n[i, 2] = 0.0
     for t in range(f.shape[0]):
         a, b, c = f[t, 0], f[t, 1], f[t, 2]
         e1x, e1y, e1z = v[b, 0] - v[a, 0], v[b, 1] - v[a, 1], v[b, 2] - v[a, 2]
@@ -723,14 +727,7 @@ def surface_normals(v, f, adj, face_n, edge_n, vert_n):
         else:
             nx, ny, nz = 0.0, 0.0, 0.0
         face_n[t, 0], face_n[t, 1], face_n[t, 2] = nx, ny, nz
-    for i in range(nv):
-        vert_n[i, 0] = 0.0
-        vert_n[i, 1] = 0.0
-        vert_n[i, 2] = 0.0
-    corner = np.empty((nv, 3))
-    for k in range(3):  # each corner's angle weights its face's normal at its vertex
-        corner[:] = 0.0
-        for t in range(f.shape[0]):
+        for k in range(3):  # each corner's angle weights the face's normal at its vertex
             p, q, r = f[t, k], f[t, (k + 1) % 3], f[t, (k + 2) % 3]
             ux, uy, uz = v[q, 0] - v[p, 0], v[q, 1] - v[p, 1], v[q, 2] - v[p, 2]
             wx, wy, wz = v[r, 0] - v[p, 0], v[r, 1] - v[p, 1], v[r, 2] - v[p, 2]
@@ -738,13 +735,9 @@ def surface_normals(v, f, adj, face_n, edge_n, vert_n):
             lw = math.sqrt(wx * wx + wy * wy + wz * wz)
             cosang = ((ux * wx + uz * wz) + uy * wy) / max(lu * lw, 1e-300)  # the order numpy's einsum adds in
             ang = math.acos(min(1.0, max(-1.0, cosang)))
-            corner[p, 0] += face_n[t, 0] * ang
-            corner[p, 1] += face_n[t, 1] * ang
-            corner[p, 2] += face_n[t, 2] * ang
-        for i in range(nv):
-            vert_n[i, 0] += corner[i, 0]
-            vert_n[i, 1] += corner[i, 1]
-            vert_n[i, 2] += corner[i, 2]
+            vert_n[p, 0] += nx * ang
+            vert_n[p, 1] += ny * ang
+            vert_n[p, 2] += nz * ang
     for t in range(f.shape[0]):
         for k in range(3):
             o = adj[t, k]
