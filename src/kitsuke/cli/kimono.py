@@ -41,7 +41,8 @@ from the left-to-right hip axis; 90° = the right leg forward), the default body
 spreads its straight legs apart along θ, a little more each frame, with the kimono simulated. The widest spread
 before the kimono breaks is E(θ), bisected from the first spread that broke. It breaks when the cloth below the obi
 tears (1 % more of its edges stretched over 10 % than standing), a leg shows through it at the joint's height (or
-the hem's), or cloth is pushed 5 mm into the skin (0.5 % more of it than standing). A is the kimono's
+the hem's: over 5 % of that band of the leg uncovered), or cloth is pushed 5 mm into the skin (0.5 % more of it
+than standing). A is the kimono's
 cross-section area at the joints' height. The table (-o) is what `kitsuke pose correct --constraints` reads; the
 table shipped as "calibrated" (`--constraints calibrated`) was made by the first example.
 

@@ -12,10 +12,11 @@ try starts again from that frame's cloth (the simulation is reused, not replayed
 
 The kimono breaks (`BreakThresholds`) when, after a frame:
 - the cloth below the obi is torn: `torn_fraction` more of its edges stretched over `torn_strain` than standing;
-- a leg shows outside the cloth: a point of either leg's skin within `band_m` of the joint's height (or of the
-  hem's, for a joint below it) has no cloth of that band over it, seen from above: none ahead of it along its
-  skin's outward normal within `window_m` of that ray (`uncovered`: the leg shows through the kimono's opened
-  front, or past its edge);
+- a leg shows outside the cloth: more than `uncovered_fraction` of either leg's skin points within `band_m` of the
+  joint's height (or of the hem's, for a joint below it) have no cloth of that band over them, seen from above:
+  none ahead of a point along its skin's outward normal within `window_m` of that ray (`uncovered`: the leg shows
+  through the kimono's opened front, or past its edge). One point alone decided E before (a point at the back of a
+  knee, uncovered for a frame, set the knees' E at 45° 10 cm short);
 - cloth is pushed into the body: `inside_fraction` more of the cloth below the obi is over `inside_m` inside the
   skin it lies on than standing.
 A (the cross-section area of K) is the area of that hull at the joint's height on the dressed kimono, standing.
@@ -53,6 +54,7 @@ class BreakThresholds:
     torn_fraction: float = 0.01
     band_m: float = 0.03
     window_m: float = 0.03
+    uncovered_fraction: float = 0.05
     inside_m: float = 0.005
     inside_fraction: float = 0.005
 
@@ -221,8 +223,10 @@ class _Spread:
             cloth = x[np.abs(x[:, 1] - y) <= t.band_m][:, [0, 2]]
             leg = self.leg_vertices[side]
             leg = leg[(np.abs(skin[leg, 1] - y) <= t.band_m) & (np.abs(normals[leg, 1]) < 0.7)]  # its sides
-            if len(leg) and uncovered(skin[leg][:, [0, 2]], normals[leg][:, [0, 2]], cloth, t.window_m).any():
-                return "leg outside"
+            if len(leg):
+                shows = uncovered(skin[leg][:, [0, 2]], normals[leg][:, [0, 2]], cloth, t.window_m)
+                if shows.mean() > t.uncovered_fraction:
+                    return "leg outside"
         if inside - self.baseline[1] > t.inside_fraction * int(self.skirt.sum()):
             return "pushed inside"
         return None
