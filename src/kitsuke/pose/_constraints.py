@@ -159,8 +159,8 @@ def write_constraints(table: ConstraintTable, path: str | os.PathLike[str]) -> P
 
 def default_constraints() -> ConstraintTable:
     """The table kitsuke corrects with by default: the standard kimono's geometric estimate. The table calibrated
-    by simulation (`packaged_constraints("calibrated")`) is not the default yet: it allows 20-60 % wider spreads
-    and does not yet grow with a wider kimono at every angle (BENCHMARKS.md)."""
+    by simulation (`packaged_constraints("calibrated")`) is not the default yet: it allows 20-60 % wider spreads,
+    wider than a kimono allows (the simulated cloth lets legs that ask too much pass through it; BENCHMARKS.md)."""
     return packaged_constraints("geometric")
 
 
