@@ -160,7 +160,7 @@ def write_constraints(table: ConstraintTable, path: str | os.PathLike[str]) -> P
 def default_constraints() -> ConstraintTable:
     """The table kitsuke corrects with by default: the standard kimono's geometric estimate. The table calibrated
     by simulation (`packaged_constraints("calibrated")`) is not the default yet: it allows 20-60 % wider spreads,
-    wider than a kimono allows (the simulated cloth lets legs that ask too much pass through it; BENCHMARKS.md)."""
+    and its ankles with one leg forward are set by the hem lifting over the back calf (BENCHMARKS.md)."""
     return packaged_constraints("geometric")
 
 
