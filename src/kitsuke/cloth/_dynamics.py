@@ -3,9 +3,10 @@
 
 Each step of `dt` seconds runs `DynamicsParams.substeps` substeps of h = dt / substeps, each:
 1. predict: gravity into the velocities, positions moved by h·v (`_dynamics_kernels.predict`);
-2. one Gauss-Seidel sweep of stretch constraints (every mesh edge keeps its rest length, compliance
-   `stretch_compliance`) and of bending constraints (the two vertices opposite each interior edge keep their flat
-   rest distance, compliance `bend_compliance`): XPBD, so stiffness does not depend on h or the sweep count;
+2. `sweeps` Gauss-Seidel sweeps of stretch constraints (every mesh edge keeps its rest length, compliance
+   `stretch_compliance`) and one of bending constraints (the two vertices opposite each interior edge keep their
+   flat rest distance, compliance `bend_compliance`), colour by colour (`K.colour_pairs`): XPBD, so stiffness does
+   not depend on h or the sweep count;
 3. `contact_rounds` rounds of: collision with the moving body's capsules, pushed `contact_offset_m` outside with
    Coulomb friction (the capsules move a substep's share of their frame motion each substep: sub-stepped, so a
    fast leg does not pass through the cloth in one frame), then the strain limit: no edge longer than
