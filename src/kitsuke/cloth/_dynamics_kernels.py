@@ -158,7 +158,8 @@ def _push_out_of_capsule(
     offset: float,
     friction: float,
 ) -> bool:
-    """Push vertex i out of capsule k plus `offset`, with friction (`collide_capsules`); whether it was inside."""
+    """Push vertex i out of capsule k plus `offset`, with friction (`collide_capsule_pairs`); whether it was
+    inside."""
     t, cx, cy, cz, ux, uy, uz, uu = _capsule_point(p, i, ends, k)
     r = radii[k, 0] + t * (radii[k, 1] - radii[k, 0]) + offset
     nx, ny, nz = p[i, 0] - cx, p[i, 1] - cy, p[i, 2] - cz
@@ -192,32 +193,6 @@ def _push_out_of_capsule(
         p[i, 1] -= cut * ty
         p[i, 2] -= cut * tz
     return True
-
-
-@njit(cache=True)
-def collide_capsules(
-    p: np.ndarray,
-    x: np.ndarray,
-    inv_mass: np.ndarray,
-    ends: np.ndarray,
-    radii: np.ndarray,
-    moved: np.ndarray,
-    offset: float,
-    friction: float,
-) -> int:
-    """Push every free vertex out of the tapered capsules (n, 2, 3) ends, (n, 2) radii, plus `offset` metres, and
-    apply Coulomb friction: the vertex's move this substep relative to the capsule's surface (`moved` (n, 2, 3):
-    how far each capsule end moved this substep) loses up to `friction` times the push along the surface.
-    Returns the number of vertices pushed."""
-    pushed = 0
-    box = _capsule_boxes(ends, radii, offset)  # most vertices are far from most capsules
-    for i in range(p.shape[0]):
-        if inv_mass[i] == 0.0:
-            continue
-        for k in range(ends.shape[0]):
-            if _in_box(p, i, box, k) and _push_out_of_capsule(p, x, i, k, ends, radii, moved, offset, friction):
-                pushed += 1
-    return pushed
 
 
 @njit(cache=True)
@@ -255,7 +230,10 @@ def collide_capsule_pairs(
     pairs: np.ndarray,
     n_pairs: int,
 ) -> int:
-    """`collide_capsules` for the first `n_pairs` (vertex, capsule) pairs (`capsule_candidates`) alone."""
+    """Push the vertex of each of the first `n_pairs` (vertex, capsule) pairs (`capsule_candidates`) out of its
+    tapered capsule (ends (n, 2, 3), radii (n, 2)) plus `offset` metres, with Coulomb friction: the vertex's move
+    this substep relative to the capsule's surface (`moved` (n, 2, 3): how far each capsule end moved this
+    substep) loses up to `friction` times the push along the surface. Returns the number of pushes."""
     pushed = 0
     for m in range(n_pairs):
         if _push_out_of_capsule(p, x, pairs[m, 0], pairs[m, 1], ends, radii, moved, offset, friction):
