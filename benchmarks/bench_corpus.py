@@ -17,7 +17,8 @@ stroke left out). Each is dressed with `wrap` and sorted into:
 - garbage: written as a garment (no error) yet not on the body by `kitsuke.dressing.on_body_failures`; this
   must stay 0.
 
-It prints a table per design and the shares, the median and worst time, and with `--drag` a 5 cm lift and a 3 cm
+It prints a table per design (with its GarmentCode components: `garment_kind`) and the shares, the same by
+component, the median and worst time, and with `--drag` a 5 cm lift and a 3 cm
 turn of each written garment by a point on its front (`DragSession`), released, once freely and once with its back
 pinned, beside the wrap (within targets: the corpus ones), counted over the garments that were within targets
 before the drag and over all written.
@@ -65,13 +66,26 @@ def sample(seed: int, n: int, out: Path, sampler: Path = SAMPLER) -> list[Path]:
     return sorted(out.glob("*_specification.json"))
 
 
+def garment_kind(path: Path) -> str:
+    """What GarmentCode made, from the design file beside the specification (its `meta`: upper, bottom and
+    waistband components, e.g. "Shirt+SkirtCircle", "Pants+StraightWB"); "?" without one."""
+    design = path.with_name(path.name.replace("_specification", "_design"))
+    try:
+        doc = json.loads(design.read_text())
+    except (OSError, ValueError):
+        return "?"
+    meta = doc.get("design", doc).get("meta", {})
+    parts = [meta.get(k, {}).get("v") for k in ("upper", "bottom", "wb")]
+    return "+".join(str(v) for v in parts if v) or "?"
+
+
 def dress_one(path: Path, body, collider, surface, rng, perturb: bool, drag: bool, params=None) -> dict:
     from kitsuke.dressing import on_body_failures, perturb_strokes, suggest_strokes, target_misses, wrap
     from kitsuke.errors import ComputationError, InputError
     from kitsuke.metrics import QualityTargets
     from kitsuke.pattern import load_pattern
 
-    row: dict = {"design": path.stem.replace("_specification", "")}
+    row: dict = {"design": path.stem.replace("_specification", ""), "kind": garment_kind(path)}
     t0 = time.perf_counter()
     try:
         pattern = load_pattern(path)
@@ -158,6 +172,7 @@ def dress_batch(paths: list[Path], surface, perturb: bool, runner: str, workers:
             record = json.loads((out / job.id / "result.json").read_text())
             m = record["measures"]
             row = {"design": job.id, "status": BATCH_STATUS[record["status"]], "seconds": record["seconds"]}
+            row["kind"] = garment_kind(Path(job.pattern))
             row["reason"] = record["reason"] if record["status"] != "refused" else record["reason"].split(": ", 1)[-1]
             if (out / job.id / "strokes.json").exists():
                 row["strokes"] = len(read_strokes(out / job.id / "strokes.json"))
@@ -269,7 +284,7 @@ def main() -> None:
                 row["seed"] = seed
                 rows.append(row)
                 print(
-                    f"{row['design']:16s} {row['status']:13s} {row.get('seconds', 0):6.1f} s  "
+                    f"{row['design']:16s} {row['kind'][:28]:28s} {row['status']:13s} {row.get('seconds', 0):6.1f} s  "
                     f"mean {100 * row.get('strain_mean', np.nan):5.2f} %  "
                     f"max {100 * row.get('strain_max', np.nan):6.1f} %"
                     f"  deep {row.get('deepest_mm', np.nan):5.1f} mm  stroke {row.get('stroke_mm', np.nan):5.1f} mm"
@@ -282,6 +297,16 @@ def main() -> None:
     print(f"\n{n} designs, seeds {args.seeds}, {'perturbed' if not args.no_perturb else 'suggested'} strokes")
     for k, v in count.items():
         print(f"  {k:14s} {v:3d}  {100 * v / max(n, 1):5.1f} %")
+    by_part: dict[str, list[str]] = {}
+    for r in rows:  # a design counts under each of its components: which kinds of garment stay out of target
+        for part in r["kind"].split("+"):
+            by_part.setdefault(part, []).append(r["status"])
+    print("  by component (within targets / out of target / failed or refused, designs with it):")
+    for part, got in sorted(by_part.items(), key=lambda kv: -len(kv[1])):
+        print(
+            f"    {part:16s} {got.count('ok'):3d} / {got.count('out of target'):3d} / "
+            f"{got.count('failed') + got.count('refused'):3d}   of {len(got)}"
+        )
     if times:
         print(f"  time: median {np.median(times):.1f} s, worst {max(times):.1f} s")
     if args.drag:
