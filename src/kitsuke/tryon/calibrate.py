@@ -15,8 +15,8 @@ The kimono breaks (`BreakThresholds`) when, after a frame:
 - a leg shows outside the cloth: more than `uncovered_fraction` of either leg's skin points within `band_m` of the
   joint's height (or of the hem's, for a joint below it) have no cloth of that band over them, seen from above:
   none ahead of a point along its skin's outward normal within `window_m` of that ray (`uncovered`: the leg shows
-  through the kimono's opened front, or past its edge). One point alone decided E before (a point at the back of a
-  knee, uncovered for a frame, set the knees' E at 45° 10 cm short);
+  through the kimono's opened front, or past its edge). A share, not one point: a point at the back of a knee
+  uncovered for a single frame would set the knees' E 10 cm short;
 - cloth is pushed into the body: `inside_fraction` more of the cloth below the obi is over `inside_m` inside the
   skin it lies on than standing.
 A (the cross-section area of K) is the area of that hull at the joint's height on the dressed kimono, standing.
