@@ -101,6 +101,20 @@ def test_cloth_flung_far_from_the_body_is_not_a_garment(drawn_up):
     assert on_body_failures(drawn_up, _sphere(0.3)) == []
 
 
+def test_cloth_resting_on_the_floor_is_not_flung(drawn_up):
+    """A gown's train pools on the floor half a metre from the feet: worn, not flung. The floor is the body's
+    lowest point; the same vertex 60 cm off the body in the air is (the test above)."""
+    import copy
+
+    sphere = _sphere(0.3)
+    pooled = copy.copy(drawn_up)
+    pooled.positions = drawn_up.positions.copy()
+    pooled.positions[0] = [0.6, sphere.vertices[:, 1].min() + 0.01, 0.5]
+    failures = on_body_failures(pooled, sphere)
+    assert not any("from the body" in f for f in failures)
+    assert any("is torn" in f for f in failures)  # one vertex pulled that far still tears its edges
+
+
 def test_a_garment_on_the_body_reports_the_targets_it_misses(drawn_up):
     assert on_body_failures(drawn_up, _sphere(0.3)) == []
     strict = QualityTargets(max_strain=1e-4, stroke_residual_mm=0.1)

@@ -116,7 +116,8 @@ def register(parser: argparse.ArgumentParser) -> None:
         dest="settings",
         help="change one of the wrap's settings by its dotted name, applied after the options above (repeatable; "
         "e.g. --set settle.method=global --set polish.passes=1 --set grow.hang=1.5); the groups are grow, close, "
-        "settle, lengths, tethers, untangle and polish (kitsuke.dressing.WrapParams)",
+        "settle, drape, lengths, tethers, untangle and polish (kitsuke.dressing.WrapParams; --set drape.seconds=0 "
+        "skips the drape of hanging cloth)",
     )
     add_body_options(parser)
     parser.set_defaults(run=run)

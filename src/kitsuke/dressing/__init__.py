@@ -73,6 +73,7 @@ from .suggest import SuggestParams, suggest_strokes
 from .wrap import DressedGarment, WrapParams, wrap
 from .wrap_settings import (
     CloseSettings,
+    DrapeSettings,
     GrowSettings,
     LengthSettings,
     SettleSettings,
@@ -124,6 +125,7 @@ __all__ = [
     "GrowSettings",
     "CloseSettings",
     "SettleSettings",
+    "DrapeSettings",
     "LengthSettings",
     "TetherSettings",
     "UntangleSettings",

@@ -20,11 +20,24 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, Tethers, relax, restore_lengths, untangle
+from ..cloth import (
+    BodyCollider,
+    ClothModel,
+    ClothParams,
+    ClothState,
+    DynamicsParams,
+    MovingBody,
+    Tethers,
+    dynamics_data,
+    relax,
+    restore_lengths,
+    step,
+    untangle,
+)
 from ..errors import ComputationError
 from ._grow import grow
 from ._solve import GlobalRelax, gravity_settle
-from .wrap_settings import CloseSettings, GrowSettings, LengthSettings, SettleSettings
+from .wrap_settings import CloseSettings, DrapeSettings, GrowSettings, LengthSettings, SettleSettings
 
 Stage = Callable[[ClothModel, ClothState, BodyCollider, object], dict]
 
@@ -159,6 +172,46 @@ def settle_stage(model: ClothModel, state: ClothState, collider: BodyCollider, c
             contact_weight=config.contact_weight,
         )
     return {"iterations": s.iterations}
+
+
+@dataclass(frozen=True)
+class Draping:
+    """drape_stage's config: the settings."""
+
+    settings: DrapeSettings
+
+
+#: The drape's steps per simulated second.
+DRAPE_FPS = 30
+
+
+def drape_stage(model: ClothModel, state: ClothState, collider: BodyCollider, config: Draping) -> dict:
+    """Let the cloth hanging off the body fall under gravity (the dynamic solver), the cloth on the body held.
+    Skipped when little cloth hangs. A step that diverges (`ComputationError`) puts the cloth back where the
+    stage found it: the garment is then as the settle left it."""
+    s = config.settings
+    frames = int(round(s.seconds * DRAPE_FPS))
+    if not frames or not model.n_vertices:
+        return {"frames": 0}
+    # A global query, not the tracked contacts: a skipped drape leaves the state exactly as it was.
+    _, _, distance = collider.nearest(state.positions)
+    hanging = float((distance >= s.hanging_m).mean())
+    if hanging < s.min_hanging:
+        return {"frames": 0, "hanging": round(hanging, 4)}
+    held = state.pinned | (distance < s.hold_m)
+    view = state.holding(held)
+    before = state.positions.copy()
+    params = DynamicsParams(damping=s.damping)
+    data = dynamics_data(model, params)
+    body = MovingBody.of(collider)
+    try:
+        for _ in range(frames):
+            step(model, view, body, 1.0 / DRAPE_FPS, params, data)
+    except ComputationError:
+        state.positions[:] = before
+        return {"frames": frames, "hanging": round(hanging, 4), "diverged": True}
+    state.velocities = None
+    return {"frames": frames, "hanging": round(hanging, 4), "held": int(held.sum())}
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,8 @@
 Two different questions, with two different answers for a user:
 
 - `on_body_failures(garment, body)`: what makes the result *not a garment on the body* — non-finite positions, a
-  piece that lies far off the body, cloth torn (edges stretched to more than twice their length), a stroke
+  piece that lies far off the body, cloth far from it in the air (cloth resting on the floor is worn: a gown's
+  train), cloth torn (edges stretched to more than twice their length), a stroke
   whose cloth ended far from where it was drawn. Any of these and `wrap` raises `ComputationError` (the CLI:
   exit 1, nothing written as if it worked; `--keep-failed` writes it as `*.failed.*`).
 - `target_misses(garment, targets)`: the quality targets a garment on the body misses (SPEC §6 plus stroke
@@ -23,6 +24,9 @@ OFF_BODY_M = 0.10
 #: Cloth farther than this from the body is not worn, metres (the demo kimono's sleeves hang at most 22 cm off
 #: it; a flap of a failed wrap was found 63 cm off, written with exit 0, on corpus seed 4179).
 FAR_CLOTH_M = 0.50
+#: Cloth within this height of the floor (the soles' height) rests on it: a gown's train pooled round the feet is
+#: worn, however far from the body it spreads, metres.
+ON_FLOOR_M = 0.03
 #: An edge longer than (1 + this) times its rest length is torn.
 TORN_STRAIN = 1.0
 #: A stroke whose cloth lies farther than this from its body stroke has left where it was drawn, metres.
@@ -55,8 +59,11 @@ def on_body_failures(garment, body, *, surface: Surface | None = None) -> list[s
         d = dist[piece == k]
         if len(d) and d.min() > OFF_BODY_M:
             out.append(f"piece {name} lies {100 * d.min():.0f} cm off the body")
-    far = int(np.argmax(dist)) if len(dist) else -1
-    if far >= 0 and dist[far] > FAR_CLOTH_M and not out:
+    # Cloth lying on the floor is held up by it, not by the body: not counted as far.
+    floor_y = float(mesh.vertices[:, 1].min())
+    aloft = np.where(pos[:, 1] > floor_y + ON_FLOOR_M, dist, 0.0)
+    far = int(np.argmax(aloft)) if len(dist) else -1
+    if far >= 0 and aloft[far] > FAR_CLOTH_M and not out:
         k = piece[far]
         out.append(
             f"piece {garment.piece_names[k] if k >= 0 else '?'}: cloth {100 * dist[far]:.0f} cm from the body at "

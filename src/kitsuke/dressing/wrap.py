@@ -24,6 +24,11 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
    steps with gravity, the body contacts inside the solve and static friction: `_solve.gravity_settle`).
    Optionally a band of the garment (e.g. where a kimono's obi goes) is held: its vertices over the torso are
    pinned where they are after step 3 (`_band_held`), for the settle only (the finish has no gravity).
+4b. **Drape** (`_stages.drape_stage`): where much of the garment hangs off the body (a flared skirt, a gown),
+   the hanging cloth falls under gravity for a simulated second in the dynamic solver (`kitsuke.cloth.step`,
+   XPBD with the body's collision and a 2 % strain limit), the cloth resting on the body held where the settle
+   left it. A relaxation from a flat start cannot let a flare fall: its hem would have to gather into folds
+   first, so a circle skirt's sides stayed out as flat wings. Cloth that reaches the floor rests on it.
 5. **Finish**: Gauss-Seidel sweeps projecting each edge to its rest length, Chebyshev-accelerated, take back the
    stretch the settle's gravity left in cloth resting on the body and the local strain (`lengths`,
    `kitsuke.cloth.restore_lengths`; optionally after a few global relaxation steps without gravity,
@@ -43,9 +48,9 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
    than the targets (1 %, 10 mm, none, the layer gap). While the max strain is over 5 %, a second pass. A refined
    garment has more faces than its pattern mesh (`DressedGarment.faces`).
 
-Steps 2-6 are stages of `_stages` (`stage(model, state, collider, config) -> stats`, each given the pins it holds
-as a view of the state, timed, announced to `progress` and checked for non-finite positions); their settings are
-`WrapParams`' groups (`wrap_settings`), one per stage.
+Steps 2-6 (and 4b) are stages of `_stages` (`stage(model, state, collider, config) -> stats`, each given the pins
+it holds as a view of the state, timed, announced to `progress` and checked for non-finite positions); their
+settings are `WrapParams`' groups (`wrap_settings`), one per stage.
 
 Layered cloth (a pattern's `meta["layers"]`: the kimono's left front over its right, SPEC §5.4) keeps its layer
 order in every collision update of every step (`kitsuke.cloth.keep_layers`), so the fronts never grow or settle
@@ -74,6 +79,7 @@ from ._polish_step import polish_step
 from ._refined import pieces_contiguous, remap_track, reorder_state
 from ._stages import (
     Closing,
+    Draping,
     Finishing,
     Growing,
     Settling,
@@ -81,6 +87,7 @@ from ._stages import (
     Untangling,
     check_finite,
     close_stage,
+    drape_stage,
     finish_stage,
     grow_stage,
     run_stage,
@@ -384,6 +391,8 @@ def wrap(
     loose = settled > p.tethers.slack_m
     if p.tethers.reach_m is not None and not loose.all():
         tethers = _tethers(placement.tracks, loose, model.faces, p.tethers.reach_m)
+    # After the strokes are judged: the finish's tethers pull back a stroke the falling cloth took with it.
+    run_stage(log, "draping", drape_stage, model, state, collider, Draping(p.drape), pinned=pins, timing="drape")
 
     def finish_and_polish(state: ClothState, tethers: Tethers | None, loose: np.ndarray) -> _Finished:
         """Steps 5-7 from the settled `state`."""

@@ -165,6 +165,34 @@ class SettleSettings:
 
 
 @dataclass(frozen=True)
+class DrapeSettings:
+    """Step 4b, the drape: cloth hanging off the body falls under gravity, in the dynamic solver
+    (`kitsuke.cloth.step`, XPBD), while the cloth resting on the body is held where the settle left it. The static
+    settle cannot let a flare fall: a circle skirt's sides stay out as flat wings, because falling means their
+    hem gathering into folds, which a relaxation from a flat start never begins.
+
+    seconds : simulated time (at 30 steps a second); 0 turns the drape off.
+    hold_m : cloth closer to the body than this (metres) is held.
+    min_hanging : the drape runs only when at least this share of the vertices lies `hanging_m` or more off the
+        body (GarmentCode's shirt, 4 % of it 5 cm off, skips it; a circle skirt has 50-60 %).
+    hanging_m : see min_hanging, metres.
+    damping : fraction of the velocity lost per second.
+    """
+
+    seconds: float = 1.0
+    hold_m: float = 0.01
+    min_hanging: float = 0.10
+    hanging_m: float = 0.05
+    damping: float = 2.0
+
+    def __post_init__(self) -> None:
+        if not (self.seconds >= 0 and self.hold_m >= 0 and self.hanging_m >= 0 and self.damping >= 0):
+            raise InputError("DrapeSettings.seconds, .hold_m, .hanging_m and .damping must be >= 0")
+        if not 0 <= self.min_hanging <= 1:
+            raise InputError("DrapeSettings.min_hanging must be a share in [0, 1]")
+
+
+@dataclass(frozen=True)
 class LengthSettings:
     """Step 5, the finish: global steps without gravity (optional), then Gauss-Seidel sweeps projecting every
     edge to its rest length (`kitsuke.cloth.restore_lengths`), which take back the stretch the settle left.
@@ -255,6 +283,7 @@ class WrapParams:
     grow: GrowSettings = field(default_factory=GrowSettings)
     close: CloseSettings = field(default_factory=CloseSettings)
     settle: SettleSettings = field(default_factory=SettleSettings)
+    drape: DrapeSettings = field(default_factory=DrapeSettings)
     lengths: LengthSettings = field(default_factory=LengthSettings)
     tethers: TetherSettings = field(default_factory=TetherSettings)
     untangle: UntangleSettings = field(default_factory=UntangleSettings)
@@ -268,6 +297,7 @@ class WrapParams:
             "grow": GrowSettings,
             "close": CloseSettings,
             "settle": SettleSettings,
+            "drape": DrapeSettings,
             "lengths": LengthSettings,
             "tethers": TetherSettings,
             "untangle": UntangleSettings,
