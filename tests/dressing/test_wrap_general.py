@@ -115,6 +115,21 @@ def test_cloth_resting_on_the_floor_is_not_flung(drawn_up):
     assert any("is torn" in f for f in failures)  # one vertex pulled that far still tears its edges
 
 
+def test_a_piece_on_the_other_side_from_its_placement_is_not_a_garment(drawn_up):
+    """The square lies on the sphere's front: placed at its back, it is on the wrong side (a corpus skirt's front
+    was found hanging off the back left of the hip, within every other target); placed at its front, it is not."""
+    import copy
+    import dataclasses
+
+    pm = drawn_up.pattern_mesh
+    at = drawn_up.positions[drawn_up.pattern_vertex]
+    for placed_z, wrong in ((1.0, False), (-1.0, True)):
+        g = copy.copy(drawn_up)
+        g.pattern_mesh = dataclasses.replace(pm, positions_m=at * [1.0, 1.0, placed_z], placed=np.ones(1, dtype=bool))
+        expected = ["piece square ended at the body's front; its placement puts it at the back"] if wrong else []
+        assert on_body_failures(g, _sphere(0.3)) == expected
+
+
 def test_a_garment_on_the_body_reports_the_targets_it_misses(drawn_up):
     assert on_body_failures(drawn_up, _sphere(0.3)) == []
     strict = QualityTargets(max_strain=1e-4, stroke_residual_mm=0.1)

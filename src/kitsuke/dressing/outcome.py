@@ -4,9 +4,10 @@ Two different questions, with two different answers for a user:
 
 - `on_body_failures(garment, body)`: what makes the result *not a garment on the body* — non-finite positions, a
   piece that lies far off the body, cloth far from it in the air (cloth resting on the floor is worn: a gown's
-  train), cloth torn (edges stretched to more than twice their length), a stroke
-  whose cloth ended far from where it was drawn. Any of these and `wrap` raises `ComputationError` (the CLI:
-  exit 1, nothing written as if it worked; `--keep-failed` writes it as `*.failed.*`).
+  train), cloth torn (edges stretched to more than twice their length), a piece on the other side of the body
+  from where its placement puts it, a stroke whose cloth ended far from where it was drawn. Any of these and
+  `wrap` raises `ComputationError` (the CLI: exit 1, nothing written as if it worked; `--keep-failed` writes it
+  as `*.failed.*`).
 - `target_misses(garment, targets)`: the quality targets a garment on the body misses (SPEC §6 plus stroke
   adherence); it is written, and the misses are said on stderr and in the report.
 """
@@ -31,6 +32,45 @@ ON_FLOOR_M = 0.03
 TORN_STRAIN = 1.0
 #: A stroke whose cloth lies farther than this from its body stroke has left where it was drawn, metres.
 STROKE_LOST_M = 0.05
+
+
+#: A piece and its placement are compared only where both lie at least this far out from the body's vertical axis,
+#: metres (a waistband round the waist has no side).
+SIDE_M = 0.05
+#: A piece is on the wrong side when its direction round the body's axis and its placement's differ by more than
+#: this, degrees (front against back is 180; a kimono's left front, placed open at the front left, crosses to
+#: the front right when worn: 90).
+WRONG_SIDE_DEG = 120.0
+
+
+def _side(v: np.ndarray) -> str:
+    """'front', 'back left', ... for a horizontal direction (x, z) from the body's axis (facing +Z, its left +X)."""
+    names = ["front", "front left", "left", "back left", "back", "back right", "right", "front right"]
+    return names[int(np.round(np.degrees(np.arctan2(v[0], v[1])) / 45.0)) % 8]
+
+
+def wrong_side(garment, mesh: TriMesh) -> list[str]:
+    """Pieces that ended on the other side of the body from where their placement puts them (a skirt's front
+    found hanging off the back left of the hip), one line each. Pieces without a placement are not judged."""
+    pm = getattr(garment, "pattern_mesh", None)
+    vertex_of = getattr(garment, "pattern_vertex", None)
+    if pm is None or vertex_of is None or len(vertex_of) != pm.n_vertices:
+        return []
+    lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+    axis = 0.5 * (lo + hi)[[0, 2]]
+    out = []
+    for k, name in enumerate(pm.piece_names):
+        if not pm.placed[k]:
+            continue
+        a, b = pm.piece_vertices[k]
+        placed = pm.positions_m[a:b].mean(axis=0)[[0, 2]] - axis
+        worn = garment.positions[vertex_of[a:b]].mean(axis=0)[[0, 2]] - axis
+        lp, lw = np.linalg.norm(placed), np.linalg.norm(worn)
+        if lp < SIDE_M or lw < SIDE_M:
+            continue
+        if np.dot(placed, worn) < np.cos(np.radians(WRONG_SIDE_DEG)) * lp * lw:
+            out.append(f"piece {name} ended at the body's {_side(worn)}; its placement puts it at the {_side(placed)}")
+    return out
 
 
 def _piece_of_vertex(garment) -> np.ndarray:
@@ -80,6 +120,7 @@ def on_body_failures(garment, body, *, surface: Surface | None = None) -> list[s
             f"piece {garment.piece_names[k] if k >= 0 else '?'} is torn: an edge at {ratio[worst]:.1f}x its length"
             f" at ({', '.join(f'{c:.2f}' for c in pos[e[worst, 0]])}) m"
         )
+    out += wrong_side(garment, mesh)
     for sid, r in zip(garment.stroke_ids, garment.stroke_residual_m, strict=True):
         if not r <= STROKE_LOST_M:
             out.append(f"stroke {sid}: its cloth ended {100 * r:.0f} cm from the body stroke")

@@ -271,9 +271,9 @@ class WrapParams:
     """Settings of `wrap`, one group per stage (see each group's docstring).
 
     edge_length_cm : target triangle edge length when `wrap` meshes a Pattern itself, cm.
-    grow, close, settle, lengths, tethers, untangle, polish : the stages' settings. The polish (step 7; kept only
-        where it is better, `_polish_step`) runs `polish.passes` passes while the max strain is over 5 %; its
-        untangle follows `untangle`.
+    grow, close, settle, drape, lengths, tethers, untangle, polish : the stages' settings. The polish (step 7;
+        kept only where it is better, `_polish_step`) runs `polish.passes` passes while the max strain is over 5 %;
+        its untangle follows `untangle`.
     cloth : ClothParams of the Jacobi relaxation (growth, the settle), the untangle and the returned model (a later
         drag). Strain limiting is off: with the seams still strained after growth it would drag the whole garment
         towards its supports in one iteration.
