@@ -116,15 +116,18 @@ def test_cloth_resting_on_the_floor_is_not_flung(drawn_up):
 
 
 def test_a_piece_on_the_other_side_from_its_placement_is_not_a_garment(drawn_up):
-    """The square lies on the sphere's front: placed at its back, it is on the wrong side (a corpus skirt's front
-    was found hanging off the back left of the hip, within every other target); placed at its front, it is not."""
+    """The square lies on the sphere's front. Without a stroke on it, placed at the sphere's back, it is on the
+    wrong side (a corpus skirt's front was found hanging off the back left of the hip, written as out of
+    target); placed at the front, it is not. With its stroke, the stroke says where it goes, whatever the
+    placement (a garment may be worn turned round on purpose)."""
     import copy
     import dataclasses
 
     pm = drawn_up.pattern_mesh
     at = drawn_up.positions[drawn_up.pattern_vertex]
-    for placed_z, wrong in ((1.0, False), (-1.0, True)):
+    for placed_z, tracks, wrong in ((1.0, [], False), (-1.0, [], True), (-1.0, drawn_up.tracks, False)):
         g = copy.copy(drawn_up)
+        g.tracks = tracks
         g.pattern_mesh = dataclasses.replace(pm, positions_m=at * [1.0, 1.0, placed_z], placed=np.ones(1, dtype=bool))
         expected = ["piece square ended at the body's front; its placement puts it at the back"] if wrong else []
         assert on_body_failures(g, _sphere(0.3)) == expected

@@ -4,10 +4,10 @@ Two different questions, with two different answers for a user:
 
 - `on_body_failures(garment, body)`: what makes the result *not a garment on the body* — non-finite positions, a
   piece that lies far off the body, cloth far from it in the air (cloth resting on the floor is worn: a gown's
-  train), cloth torn (edges stretched to more than twice their length), a piece on the other side of the body
-  from where its placement puts it, a stroke whose cloth ended far from where it was drawn. Any of these and
-  `wrap` raises `ComputationError` (the CLI: exit 1, nothing written as if it worked; `--keep-failed` writes it
-  as `*.failed.*`).
+  train), cloth torn (edges stretched to more than twice their length), a piece without strokes on the other
+  side of the body from where its placement puts it, a stroke whose cloth ended far from where it was drawn.
+  Any of these and `wrap` raises `ComputationError` (the CLI: exit 1, nothing written as if it worked;
+  `--keep-failed` writes it as `*.failed.*`).
 - `target_misses(garment, targets)`: the quality targets a garment on the body misses (SPEC §6 plus stroke
   adherence); it is written, and the misses are said on stderr and in the report.
 """
@@ -49,27 +49,46 @@ def _side(v: np.ndarray) -> str:
     return names[int(np.round(np.degrees(np.arctan2(v[0], v[1])) / 45.0)) % 8]
 
 
+def _stroked_pieces(garment) -> set[int]:
+    """Indices of the garment's pieces that hold a stroke (its tracks' faces, by the pieces' face ranges)."""
+    pf = np.asarray(garment.piece_faces)
+    out: set[int] = set()
+    for tr in getattr(garment, "tracks", None) or []:
+        out.update(np.searchsorted(pf[:, 1], np.asarray(tr.faces), side="right").tolist())
+    return out
+
+
 def wrong_side(garment, mesh: TriMesh) -> list[str]:
-    """Pieces that ended on the other side of the body from where their placement puts them (a skirt's front
-    found hanging off the back left of the hip), one line each. Pieces without a placement are not judged."""
+    """Pieces without a stroke that ended on the other side of the body from where their placement puts them (a
+    skirt's front found hanging off the back left of the hip), one line each. The strokes may turn the whole
+    garment (a skirt worn back to front on purpose): each piece is judged against its placement turned as the
+    stroked pieces turned theirs (on average round the body's vertical axis). Pieces with a stroke are judged by
+    their strokes (`STROKE_LOST_M`), pieces without a placement not at all."""
     pm = getattr(garment, "pattern_mesh", None)
     vertex_of = getattr(garment, "pattern_vertex", None)
     if pm is None or vertex_of is None or len(vertex_of) != pm.n_vertices:
         return []
     lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
     axis = 0.5 * (lo + hi)[[0, 2]]
-    out = []
-    for k, name in enumerate(pm.piece_names):
+    turn = {}  # piece -> (placed direction, worn direction, the turn between them in radians)
+    for k in range(len(pm.piece_names)):
         if not pm.placed[k]:
             continue
         a, b = pm.piece_vertices[k]
         placed = pm.positions_m[a:b].mean(axis=0)[[0, 2]] - axis
         worn = garment.positions[vertex_of[a:b]].mean(axis=0)[[0, 2]] - axis
-        lp, lw = np.linalg.norm(placed), np.linalg.norm(worn)
-        if lp < SIDE_M or lw < SIDE_M:
-            continue
-        if np.dot(placed, worn) < np.cos(np.radians(WRONG_SIDE_DEG)) * lp * lw:
-            out.append(f"piece {name} ended at the body's {_side(worn)}; its placement puts it at the {_side(placed)}")
+        if min(np.linalg.norm(placed), np.linalg.norm(worn)) >= SIDE_M:
+            turn[k] = (placed, worn, np.arctan2(worn[0], worn[1]) - np.arctan2(placed[0], placed[1]))
+    stroked = _stroked_pieces(garment) & set(turn)
+    garment_turn = np.angle(sum(np.exp(1j * turn[k][2]) for k in stroked)) if stroked else 0.0
+    out = []
+    for k, (placed, worn, t) in turn.items():
+        off = abs(np.angle(np.exp(1j * (t - garment_turn))))
+        if k not in stroked and off > np.radians(WRONG_SIDE_DEG):
+            out.append(
+                f"piece {pm.piece_names[k]} ended at the body's {_side(worn)}; its placement puts it at the "
+                f"{_side(placed)}"
+            )
     return out
 
 
