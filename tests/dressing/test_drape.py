@@ -9,6 +9,7 @@ import pytest
 from kitsuke.cloth import BodyCollider, ClothModel, ClothState, grid_sheet
 from kitsuke.dressing._stages import Draping, drape_stage
 from kitsuke.dressing.wrap_settings import DrapeSettings
+from kitsuke.errors import InputError
 from kitsuke.metrics import strain
 
 from .test_wrap import _sphere
@@ -54,3 +55,11 @@ def test_a_garment_with_little_cloth_off_the_body_is_not_draped(collider):
     assert stats["frames"] == 0 and 0.5 < stats["hanging"] < 0.99
     assert np.array_equal(state.positions, start)
     assert drape_stage(model, state, collider, Draping(DrapeSettings(seconds=0.0)))["frames"] == 0
+
+
+@pytest.mark.parametrize(
+    "bad", [{"seconds": float("inf")}, {"hold_m": float("nan")}, {"damping": -1.0}, {"min_hanging": 2.0}]
+)
+def test_drape_settings_refuse_what_no_drape_can_do(bad):
+    with pytest.raises(InputError, match="DrapeSettings"):
+        DrapeSettings(**bad)

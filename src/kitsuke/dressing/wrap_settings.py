@@ -186,8 +186,9 @@ class DrapeSettings:
     damping: float = 2.0
 
     def __post_init__(self) -> None:
-        if not (self.seconds >= 0 and self.hold_m >= 0 and self.hanging_m >= 0 and self.damping >= 0):
-            raise InputError("DrapeSettings.seconds, .hold_m, .hanging_m and .damping must be >= 0")
+        values = (self.seconds, self.hold_m, self.hanging_m, self.damping)
+        if not all(np.isfinite(v) and v >= 0 for v in values):
+            raise InputError("DrapeSettings.seconds, .hold_m, .hanging_m and .damping must be finite and >= 0")
         if not 0 <= self.min_hanging <= 1:
             raise InputError("DrapeSettings.min_hanging must be a share in [0, 1]")
 
