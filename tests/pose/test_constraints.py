@@ -16,6 +16,7 @@ from kitsuke.pose import (
     PairLimit,
     default_constraints,
     geometric_estimate,
+    packaged_constraints,
     read_constraints,
     write_constraints,
     write_default_constraints,
@@ -77,9 +78,11 @@ def test_shipped_table_is_the_regenerated_geometric_estimate(tmp_path):
     shipped = resources.files("kitsuke") / "assets" / "constraints" / "kimono_standard_geometric.json"
     regenerated = write_default_constraints(tmp_path / "regen.json")
     assert json.loads(shipped.read_text()) == json.loads(regenerated.read_text())
-    t = default_constraints()
+    t = packaged_constraints("geometric")
     assert t.source == "geometric estimate" and "158" in t.garment
     assert list(t.knee.theta_deg) == list(range(0, 180, 15))
+    default = default_constraints()  # the correction's default: the table calibrated by simulation
+    assert default.source == "calibrated" and list(default.knee.theta_deg) == list(range(0, 180, 15))
 
 
 def test_geometric_estimate_numbers():

@@ -15,13 +15,16 @@ from kitsuke.pose import (
     correction_measures,
     default_constraints,
     filter_poses,
+    packaged_constraints,
 )
 from kitsuke.pose import _kernels as K
 from kitsuke.pose._correct import inside_values, regions_of
 from kitsuke.pose._reference import correct_reference
 from kitsuke.skeleton import INDEX, JOINTS
 
-TABLE = default_constraints()
+#: The correction's rules are tested on the geometric estimate, whose limits these cases were drawn for; the
+#: default table (calibrated by simulation) is tested in `test_the_default_table_corrects_real_sequences`.
+TABLE = packaged_constraints("geometric")
 
 
 def standing_pose() -> np.ndarray:
@@ -71,14 +74,14 @@ def seq(frames: list[np.ndarray], valid: list[bool] | None = None) -> PoseSequen
 
 def test_pose_inside_is_left_bit_identical():
     s = seq([standing_pose()] * 3)
-    c = correct_poses(s)
+    c = correct_poses(s, TABLE)
     assert np.array_equal(c.poses.positions, s.positions)
     assert (c.status == K.INSIDE).all() and c.poses.corrected == [(), (), ()]
 
 
 def test_side_raise_is_corrected_into_k_with_smallest_angle():
     raised = raise_leg(standing_pose(), "r", "z", 40)  # right leg out to the side, knee 0.46 m from the left one
-    c = correct_poses(seq([raised]))
+    c = correct_poses(seq([raised]), TABLE)
     q = c.poses.positions[0]
     assert c.poses.corrected[0][0] == "r_knee" and c.status[0, 0] == K.ROTATED
     # first frame: K' is the current K; the corrected knee is inside it (and within 0.1 mm of its edge)
@@ -110,7 +113,7 @@ def test_previous_corrected_frame_gives_k_prime_and_gaps_restart():
         stand,
         raise_leg(stand, "r", "z", 40),
     ]
-    c = correct_poses(seq(frames, [True, True, True, False, True]))
+    c = correct_poses(seq(frames, [True, True, True, False, True]), TABLE)
     q = c.poses.positions
     # frame 2's K' is K of the corrected frame 1
     assert np.allclose(c.regions[2, 0], regions_of(q[1:2], TABLE, "knee")[0][0], atol=1e-12)
@@ -122,7 +125,7 @@ def test_previous_corrected_frame_gives_k_prime_and_gaps_restart():
 def test_gradual_side_raise_keeps_every_invariant():
     stand = standing_pose()
     degs = np.concatenate([np.linspace(0, 60, 40), np.linspace(60, 0, 40)])
-    c = correct_poses(seq([raise_leg(stand, "r", "z", d) for d in degs]))
+    c = correct_poses(seq([raise_leg(stand, "r", "z", d) for d in degs]), TABLE)
     inv = check_invariants(c)
     assert inv["ok"], inv
     assert inv["continuity_checked"] > 20
@@ -134,7 +137,7 @@ def test_gradual_side_raise_keeps_every_invariant():
 def test_out_of_reach_is_reported_not_crashed():
     stand = standing_pose()
     far = raise_leg(stand, "r", "z", 50) + np.array([1.5, 0.0, 0.0])  # the whole body jumped 1.5 m sideways
-    c = correct_poses(seq([stand, far]))
+    c = correct_poses(seq([stand, far]), TABLE)
     assert c.status[1, 0] in (K.CLOSEST, K.UNREACHABLE) and c.residual_m[1, 0] > 0
     inv = check_invariants(c)
     assert inv["unreachable"] >= 1 and inv["lengths_changed"] == 0 and inv["untouched_changed"] == 0
@@ -142,7 +145,7 @@ def test_out_of_reach_is_reported_not_crashed():
 
 def test_numba_kernel_matches_numpy_reference(balancing_raw, kick):
     for poses in (balancing_raw, kick.subset(slice(120, 200))):
-        c = correct_poses(poses, max_jump_m=np.inf, side_margin_m=np.inf)
+        c = correct_poses(poses, TABLE, max_jump_m=np.inf, side_margin_m=np.inf)
         ref, targets = correct_reference(poses.positions, poses.valid, TABLE)
         v = poses.valid
         assert np.array_equal(np.where(c.rotated, c.target, -1), targets)
@@ -158,7 +161,7 @@ def test_numba_kernel_matches_numpy_reference(balancing_raw, kick):
 @pytest.mark.parametrize("which", ["balancing", "balancing_filtered", "kick"])
 def test_real_sequences_keep_all_invariants(which, balancing_raw, kick):
     poses = {"balancing": balancing_raw, "balancing_filtered": filter_poses(balancing_raw), "kick": kick}[which]
-    c = correct_poses(poses)
+    c = correct_poses(poses, TABLE)
     inv = check_invariants(c)
     assert inv["untouched_changed"] == 0 and inv["targets_outside"] == 0 and inv["lengths_changed"] == 0, inv
     assert inv["max_length_change_m"] < 1e-9
@@ -186,7 +189,7 @@ def test_walk_invariants(walk):
     the knee along a circle that can cross the moving cylinder faster than either moves); on this clip 29 of 1194
     checked targets break it by at most 16 mm, 5 of them horizontally (the one-frame ankle spikes of the plain
     target rule are gone: 0 frames with both joints inside K'). Asserted as measured, so that a regression shows."""
-    c = correct_poses(walk)
+    c = correct_poses(walk, TABLE)
     inv = check_invariants(c)
     assert inv["untouched_changed"] == 0 and inv["targets_outside"] == 0 and inv["lengths_changed"] == 0
     assert inv["continuity_broken"] <= 0.03 * inv["continuity_checked"]
@@ -200,7 +203,7 @@ def test_walk_invariants(walk):
 def test_file_round_trip_keeps_invariants(tmp_path, balancing_raw):
     from kitsuke.pose import read_poses, write_poses
 
-    c = correct_poses(balancing_raw)
+    c = correct_poses(balancing_raw, TABLE)
     back = read_poses(write_poses(c.poses, tmp_path / "c.json"))
     untouched = np.array([not t for t in back.corrected])
     assert np.array_equal(back.positions[untouched & back.valid], balancing_raw.positions[untouched & back.valid])
@@ -208,7 +211,7 @@ def test_file_round_trip_keeps_invariants(tmp_path, balancing_raw):
 
 
 def test_measures_content(balancing_raw):
-    m = correction_measures(correct_poses(balancing_raw))
+    m = correction_measures(correct_poses(balancing_raw, TABLE))
     assert set(m) >= {"fraction_corrected", "residual_mm", "max_jump_m", "invariants", "time_per_frame_ms"}
     assert set(m["max_jump_m"]) == {f"{s}_{j}" for s in "lr" for j in ("knee", "ankle", "heel", "toe")}
     assert math.isclose(m["fraction_corrected"], m["corrected_frames"] / m["valid_frames"], rel_tol=1e-5)
@@ -217,7 +220,7 @@ def test_measures_content(balancing_raw):
 def test_invalid_frames_pass_through():
     stand = standing_pose()
     s = seq([stand, stand, raise_leg(stand, "r", "z", 45)], [True, False, True])
-    c = correct_poses(s)
+    c = correct_poses(s, TABLE)
     assert np.isnan(c.poses.positions[1]).all() and (c.status[1] == K.INVALID).all()
     assert c.rotated[2, 0]
 
@@ -240,7 +243,7 @@ def test_corrected_legs_keep_their_side_and_do_not_jump(case):
     else:  # the straight left leg swung forward to 80 degrees and back in half a second (16 frames at 30 fps;
         # in 12 frames one transition jumps 31 cm past the allowance: no rotation of the shin can follow)
         frames = np.stack([raise_leg(stand, "l", "x", d) for d in 80 * np.sin(np.linspace(0, np.pi, 16))])
-    c = correct_poses(seq(list(frames)))
+    c = correct_poses(seq(list(frames)), TABLE)
     inv = check_invariants(c)
     assert c.rotated.any(), "the case must need a correction"
     assert inv["sides_swapped"] == 0 and inv["jumps_over_limit"] == 0, inv
@@ -249,7 +252,7 @@ def test_corrected_legs_keep_their_side_and_do_not_jump(case):
 
 def test_without_the_rules_the_knee_raise_swaps_or_jumps():
     """The rules are what keeps the legs plausible: the SPEC's bare rotation breaks them on the same motion."""
-    c = correct_poses(seq(list(knee_raise())), max_jump_m=np.inf, side_margin_m=np.inf)
+    c = correct_poses(seq(list(knee_raise())), TABLE, max_jump_m=np.inf, side_margin_m=np.inf)
     inv = check_invariants(c)
     assert inv["sides_swapped"] > 0 or inv["jumps_over_limit"] > 0, inv
 
@@ -257,7 +260,7 @@ def test_without_the_rules_the_knee_raise_swaps_or_jumps():
 @pytest.mark.parametrize("which", ["balancing", "kick", "walk"])
 def test_real_sequences_keep_sides_and_mostly_do_not_jump(which, balancing_raw, kick, walk):
     poses = {"balancing": balancing_raw, "kick": kick, "walk": walk}[which]
-    c = correct_poses(poses)
+    c = correct_poses(poses, TABLE)
     inv = check_invariants(c)
     assert inv["sides_swapped"] == 0, inv
     if which == "balancing":
@@ -270,8 +273,30 @@ def test_real_sequences_keep_sides_and_mostly_do_not_jump(which, balancing_raw, 
         assert inv["jumps_over_limit"] <= 0.03 * poses.n_frames and inv["worst_jump_excess_m"] < 0.25, inv
 
 
+@pytest.mark.parametrize("which", ["balancing", "kick", "side_kick"])
+def test_the_default_table_corrects_real_sequences(which, balancing_raw, kick):
+    """The default table (calibrated by simulation, 20-100 % wider than the geometric estimate) still corrects the
+    large raises and the kick, keeps every invariant the rules guarantee, and swaps no sides. It lets the legs
+    reach out of K' more often: a jump past the 5 cm allowance happens only in a frame whose target is out of
+    reach, by millimetres (measured 2026-11-27: the side kick 1 jump, 2.2 mm over, with 3 frames out of reach)."""
+    assert default_constraints().source == "calibrated"
+    if which == "side_kick":
+        stand = standing_pose()
+        poses = seq([raise_leg(stand, "l", "z", d) for d in 70 * np.sin(np.linspace(0, np.pi, 30))])
+    else:
+        poses = {"balancing": balancing_raw, "kick": kick}[which]
+    c = correct_poses(poses)
+    inv = check_invariants(c)
+    assert inv["untouched_changed"] == 0 and inv["targets_outside"] == 0 and inv["lengths_changed"] == 0, inv
+    assert inv["sides_swapped"] == 0, inv
+    m = correction_measures(c)
+    assert m["residual_mm"]["max"] == 0.0 and m["corrections"]["knee"] > 10, m["corrections"]
+    if which == "side_kick":
+        assert inv["jumps_over_limit"] <= inv["unreachable"] and inv["worst_jump_excess_m"] < 0.005, inv
+
+
 def test_summary_reports_own_frame_exceedance(balancing_raw):
-    m = correction_measures(correct_poses(balancing_raw))
+    m = correction_measures(correct_poses(balancing_raw, TABLE))
     for pair in ("knee", "ankle"):
         e = m["exceeds_own_limit"][pair]
         assert set(e) == {"frames", "max_cm", "mean_cm"} and 0 <= e["mean_cm"] <= e["max_cm"]
@@ -289,8 +314,8 @@ def test_online_correction_equals_the_whole_sequence(which, balancing_raw, kick)
     valid = poses.valid.copy()
     valid[len(valid) // 3] = False  # a dropped frame restarts K' mid-clip
     poses.valid = valid
-    whole = correct_poses(poses)
-    online = OnlineCorrector()
+    whole = correct_poses(poses, TABLE)
+    online = OnlineCorrector(TABLE)
     for f in range(len(poses.positions)):
         got = online(poses.positions[f] if valid[f] else None)
         if not valid[f]:

@@ -52,7 +52,7 @@ def test_corrected_file_round_trip(tmp_path):
     back = read_poses(write_poses(c.poses, tmp_path / "c.json"))
     assert back.corrected == c.poses.corrected and "r_knee" in back.corrected[0]
     assert np.array_equal(back.raw_positions[seq.valid], seq.positions[seq.valid])
-    assert back.constraints.source == "geometric estimate"
+    assert back.constraints.source == "calibrated"
     assert np.array_equal(back.constraints.knee.max_distance_m, c.poses.constraints.knee.max_distance_m)
 
 

@@ -40,11 +40,11 @@ For each joint pair (knees, ankles) and each angle θ of the line between the tw
 from the left-to-right hip axis; 90° = the right leg forward), the default body, standing in the dressed kimono,
 spreads its straight legs apart along θ, a little more each frame, with the kimono simulated. The widest spread
 before the kimono breaks is E(θ), bisected from the first spread that broke. It breaks when the cloth below the obi
-tears (1 % more of its edges stretched over 10 % than standing), a leg shows through it at the joint's height (or
-the hem's: over 5 % of that band of the leg uncovered), or cloth is pushed 5 mm into the skin (0.5 % more of it
-than standing). A is the kimono's
-cross-section area at the joints' height. The table (-o) is what `kitsuke pose correct --constraints` reads; the
-table shipped as "calibrated" (`--constraints calibrated`) was made by the first example.
+tears (1 % more of its edges stretched over 10 % than standing), a leg shows through it at the joint's height
+(over 5 % of that band of the leg uncovered; an ankle below the hem is judged 8 cm above the hem), or cloth is
+pushed 5 mm into the skin (0.5 % more of it than standing). A is the kimono's cross-section area at the joints'
+height. The table (-o) is what `kitsuke pose correct --constraints` reads; the table shipped as "calibrated", the
+correction's default, was made by the first example.
 
 examples:
   kitsuke kimono calibrate -o kimono_standard_calibrated.json --plot e.png

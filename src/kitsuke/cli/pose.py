@@ -118,8 +118,8 @@ def register(parser: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--constraints",
         metavar="TABLE.json",
-        help="E/A table (SPEC 3.4 constraints) file, or a shipped one by name: geometric (the default, a "
-        "geometric estimate) or calibrated (by cloth simulation)",
+        help="E/A table (SPEC 3.4 constraints) file, or a shipped one by name: calibrated (the default, by "
+        "cloth simulation) or geometric (a geometric estimate)",
     )
     p.add_argument("--plot", metavar="PNG", help="write a plot of knee/ankle distances, raw and corrected, vs E(θ)")
     p.add_argument(

@@ -24,13 +24,14 @@ from ..errors import InputError
 #: Joint pairs the correction handles, in the order it handles them (SPEC §5.3: knees first, then ankles).
 PAIRS: tuple[str, ...] = ("knee", "ankle")
 
-#: The tables shipped for the standard kimono, by name: "geometric" (`geometric_estimate`; the default) and
-#: "calibrated" (cloth simulation, `kitsuke kimono calibrate`: not the default yet, see `default_constraints`).
+#: The tables shipped for the standard kimono, by name: "calibrated" (cloth simulation, `kitsuke kimono
+#: calibrate`; the default) and "geometric" (`geometric_estimate`).
 PACKAGED_CONSTRAINTS = {
     "geometric": "kimono_standard_geometric.json",
     "calibrated": "kimono_standard_calibrated.json",
 }
-DEFAULT_CONSTRAINTS_FILE = PACKAGED_CONSTRAINTS["geometric"]
+#: The shipped table the correction uses unless told otherwise.
+DEFAULT_CONSTRAINTS = "calibrated"
 
 
 @dataclass(frozen=True)
@@ -158,10 +159,9 @@ def write_constraints(table: ConstraintTable, path: str | os.PathLike[str]) -> P
 
 
 def default_constraints() -> ConstraintTable:
-    """The table kitsuke corrects with by default: the standard kimono's geometric estimate. The table calibrated
-    by simulation (`packaged_constraints("calibrated")`) is not the default yet: it allows 20-60 % wider spreads,
-    and its ankles with one leg forward are set by the hem lifting over the back calf (BENCHMARKS.md)."""
-    return packaged_constraints("geometric")
+    """The table kitsuke corrects with by default: the standard kimono's, calibrated by cloth simulation
+    (`kitsuke kimono calibrate`, SPEC §5.2). The geometric estimate is `packaged_constraints("geometric")`."""
+    return packaged_constraints(DEFAULT_CONSTRAINTS)
 
 
 def packaged_constraints(name: str) -> ConstraintTable:
@@ -302,6 +302,7 @@ def write_default_constraints(path: str | os.PathLike[str]) -> Path:
     doc = table.to_json()
     doc["derivation"] = (
         "geometric estimate from the standard kimono's hem widths and overlap; see "
-        "kitsuke.pose.geometric_estimate. Replace with a cloth-simulation calibration (SPEC 5.2)."
+        "kitsuke.pose.geometric_estimate. The default table is calibrated by cloth simulation "
+        "(kimono_standard_calibrated.json, `kitsuke kimono calibrate`)."
     )
     return write_json_atomic(path, doc)

@@ -143,7 +143,7 @@ def correct_poses(
     Parameters
     ----------
     poses : the raw (possibly filtered) poses.
-    constraints : E and A per pair; default the shipped geometric estimate (`default_constraints()`).
+    constraints : E and A per pair; default the shipped table calibrated by simulation (`default_constraints()`).
     tolerance_m : bisection stops when the target moves less than this between the bracket's ends, metres.
     samples : angles sampled over (0°, 180°] to bracket the smallest one.
     max_jump_m : a rotated joint may move at most its raw motion plus this between consecutive frames, metres.
