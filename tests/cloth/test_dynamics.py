@@ -91,7 +91,7 @@ def test_capsule_collision_matches_reference(rng):
     expect = R.collide_capsules(p, x, inv_mass, ends, radii, moved, 0.004, 0.4)
     # the kernel tests only the (vertex, capsule) pairs found near each other first
     pairs, p_k = np.empty((60 * len(ends), 2), dtype=np.int64), p.copy()
-    n = K.capsule_candidates(p_k, inv_mass, ends, radii, 0.004 + 0.02, pairs)
+    n = K.capsule_candidates(p_k, inv_mass, ends, radii, 0.004 + 0.02, np.zeros_like(p_k), 0.0, pairs)
     assert 0 < n < 60 * len(ends)  # far pairs left out
     K.collide_capsule_pairs(p_k, x, ends, radii, moved, 0.004, 0.4, pairs, n)
     np.testing.assert_allclose(p_k, expect, atol=1e-12)
@@ -271,18 +271,23 @@ def test_a_sheet_draped_over_a_bar_rests_on_it():
 
 
 def test_a_moved_body_has_the_normals_of_a_body_built_there():
-    """`BodyCollider.moved` (compiled, every frame) gives the normals `BodyCollider` computes for a body built at
-    the new pose (numpy)."""
+    """`BodyCollider.moved` (compiled, every frame) gives the face and edge normals `BodyCollider` computes for a
+    body built at the new pose (numpy); its vertex normals keep the rest pose's corner angles as weights, so they
+    agree exactly at rest and within a degree but where the pose pinches the skin (the back of a bent knee)."""
     from kitsuke.body import default_body
     from kitsuke.geometry import TriMesh
 
     body = default_body()
     collider = BodyCollider.from_body(body)
+    np.testing.assert_allclose(collider.moved(body.mesh.vertices).vertex_normals, collider.vertex_normals, atol=1e-12)
     posed = body.pose(rotations={"l_knee": [1.2, 0.0, 0.0], "r_shoulder": [0.0, 0.0, -0.8]})
     built = BodyCollider.from_mesh(TriMesh(posed.vertices, body.mesh.faces))
     moved = collider.moved(posed.vertices)
-    for name in ("face_normals", "edge_normals", "vertex_normals"):
+    for name in ("face_normals", "edge_normals"):
         np.testing.assert_allclose(getattr(moved, name), getattr(built, name), atol=1e-12, rtol=0)
+    cos = np.clip((moved.vertex_normals * built.vertex_normals).sum(axis=1), -1.0, 1.0)
+    off_deg = np.degrees(np.arccos(cos))
+    assert np.percentile(off_deg, 99) < 1.0 and (off_deg > 5.0).sum() < 20  # measured: 0.47°, 9 of 13,380
 
 
 def test_constraints_are_swept_colour_by_colour(rng):

@@ -705,12 +705,12 @@ def set_parallel(parallel: bool) -> None:
 
 
 @njit(cache=True)
-def surface_normals(v, f, adj, face_n, edge_n, vert_n):
+def surface_normals(v, f, adj, angles, face_n, edge_n, vert_n):
     """A closed surface's normals, into face_n (F, 3), edge_n (F, 3, 3) and vert_n (V, 3) (`BodyCollider`'s: unit
-    face normals, each edge's mean of its two faces' normals, angle-weighted vertex normals); v (V, 3), f (F, 3),
-    adj (F, 3) the face across each edge: `BodyCollider.moved` recomputes them every frame of a simulation, in one
-    pass over the faces (the numpy `_set_normals`'s arithmetic, summed face by face: vertex normals agree to
-    1e-15)."""
+    face normals, each edge's mean of its two faces' normals, vertex normals weighted by the corner `angles`
+    (F, 3) given); v (V, 3), f (F, 3), adj (F, 3) the face across each edge: `BodyCollider.moved` recomputes them
+    every frame of a simulation, in one pass over the faces (the numpy `_set_normals`'s arithmetic: with the
+    surface's own angles, vertex normals agree to 1e-15)."""
     nv = v.shape[0]
     for i in range(nv):
         vert_n[i, 0] = 0.0
@@ -728,13 +728,8 @@ def surface_normals(v, f, adj, face_n, edge_n, vert_n):
             nx, ny, nz = 0.0, 0.0, 0.0
         face_n[t, 0], face_n[t, 1], face_n[t, 2] = nx, ny, nz
         for k in range(3):  # each corner's angle weights the face's normal at its vertex
-            p, q, r = f[t, k], f[t, (k + 1) % 3], f[t, (k + 2) % 3]
-            ux, uy, uz = v[q, 0] - v[p, 0], v[q, 1] - v[p, 1], v[q, 2] - v[p, 2]
-            wx, wy, wz = v[r, 0] - v[p, 0], v[r, 1] - v[p, 1], v[r, 2] - v[p, 2]
-            lu = math.sqrt(ux * ux + uy * uy + uz * uz)
-            lw = math.sqrt(wx * wx + wy * wy + wz * wz)
-            cosang = ((ux * wx + uz * wz) + uy * wy) / max(lu * lw, 1e-300)  # the order numpy's einsum adds in
-            ang = math.acos(min(1.0, max(-1.0, cosang)))
+            p = f[t, k]
+            ang = angles[t, k]
             vert_n[p, 0] += nx * ang
             vert_n[p, 1] += ny * ang
             vert_n[p, 2] += nz * ang

@@ -124,11 +124,11 @@ def _capsule_boxes(ends: np.ndarray, radii: np.ndarray, reach: float) -> np.ndar
 
 
 @njit(cache=True, inline="always")
-def _in_box(p: np.ndarray, i: int, box: np.ndarray, k: int) -> bool:
+def _in_box(p: np.ndarray, i: int, box: np.ndarray, k: int, grow: float) -> bool:
     return not (
-        p[i, 0] < box[k, 0] or p[i, 0] > box[k, 3]
-        or p[i, 1] < box[k, 1] or p[i, 1] > box[k, 4]
-        or p[i, 2] < box[k, 2] or p[i, 2] > box[k, 5]
+        p[i, 0] < box[k, 0] - grow or p[i, 0] > box[k, 3] + grow
+        or p[i, 1] < box[k, 1] - grow or p[i, 1] > box[k, 4] + grow
+        or p[i, 2] < box[k, 2] - grow or p[i, 2] > box[k, 5] + grow
     )  # fmt: skip
 
 
@@ -197,21 +197,30 @@ def _push_out_of_capsule(
 
 @njit(cache=True)
 def capsule_candidates(
-    p: np.ndarray, inv_mass: np.ndarray, ends: np.ndarray, radii: np.ndarray, reach: float, out: np.ndarray
+    p: np.ndarray,
+    inv_mass: np.ndarray,
+    ends: np.ndarray,
+    radii: np.ndarray,
+    reach: float,
+    v: np.ndarray,
+    lookahead: float,
+    out: np.ndarray,
 ) -> int:
-    """The (vertex, capsule) pairs, vertex by vertex, whose free vertex lies within `reach` metres of the tapered
-    capsule's surface, into out (V * n, 2) int64; returns how many. `collide_capsule_pairs` then tests only these:
-    within a substep the collision's rounds move the cloth far less than `reach`."""
+    """The (vertex, capsule) pairs, vertex by vertex, whose free vertex lies within `reach` metres plus
+    `lookahead` seconds of its speed (v (V, 3), m/s) of the tapered capsule's surface, into out (V * n, 2) int64;
+    returns how many. `collide_capsule_pairs` then tests only these: over the substeps they serve, the collision's
+    rounds move the cloth far less than that."""
     box = _capsule_boxes(ends, radii, reach)
     n = 0
     for i in range(p.shape[0]):
         if inv_mass[i] == 0.0:
             continue
+        grow = lookahead * math.sqrt(v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1] + v[i, 2] * v[i, 2])
         for k in range(ends.shape[0]):
-            if not _in_box(p, i, box, k):
+            if not _in_box(p, i, box, k, grow):
                 continue
             t, cx, cy, cz, _, _, _, _ = _capsule_point(p, i, ends, k)
-            r = radii[k, 0] + t * (radii[k, 1] - radii[k, 0]) + reach
+            r = radii[k, 0] + t * (radii[k, 1] - radii[k, 0]) + reach + grow
             if (p[i, 0] - cx) ** 2 + (p[i, 1] - cy) ** 2 + (p[i, 2] - cz) ** 2 < r * r:
                 out[n, 0], out[n, 1] = i, k
                 n += 1
