@@ -55,7 +55,8 @@ def test_distance_sweep_matches_reference(rng, alpha):
     p, inv_mass, pairs, rest = _cloth(rng)
     lam = rng.normal(size=len(pairs)) * 0.01
     p_k, lam_k = p.copy(), lam.copy()
-    K.solve_distances(p_k, inv_mass, pairs, rest, alpha, 3 * alpha + 0.1, lam_k)
+    weights = inv_mass[pairs[:, 0]] + inv_mass[pairs[:, 1]]
+    K.solve_distances(p_k, inv_mass, pairs, rest, weights, alpha, 3 * alpha + 0.1, lam_k)
     p_r, lam_r = R.solve_distances(p, inv_mass, pairs, rest, alpha, 3 * alpha + 0.1, lam)
     np.testing.assert_allclose(p_k, p_r, atol=1e-12)
     np.testing.assert_allclose(lam_k, lam_r, atol=1e-12)
@@ -91,7 +92,9 @@ def test_capsule_collision_matches_reference(rng):
     expect = R.collide_capsules(p, x, inv_mass, ends, radii, moved, 0.004, 0.4)
     # the kernel tests only the (vertex, capsule) pairs found near each other first
     pairs, p_k = np.empty((60 * len(ends), 2), dtype=np.int64), p.copy()
-    n = K.capsule_candidates(p_k, inv_mass, ends, radii, 0.004 + 0.02, np.zeros_like(p_k), 0.0, pairs)
+    n = K.capsule_candidates(
+        p_k, inv_mass, ends, radii, np.full(len(ends), 0.004 + 0.02), np.zeros_like(p_k), 0.0, pairs
+    )
     assert 0 < n < 60 * len(ends)  # far pairs left out
     K.collide_capsule_pairs(p_k, x, ends, radii, moved, 0.004, 0.4, pairs, n)
     np.testing.assert_allclose(p_k, expect, atol=1e-12)

@@ -46,7 +46,7 @@ def register(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--constraints",
         metavar="TABLE",
-        help="E/A table for the correction: a file, or `calibrated` / `geometric` (default: calibrated, by cloth simulation)",
+        help="E/A table for the correction: a file, or `calibrated` (the default, by cloth simulation) / `geometric`",
     )
     parser.add_argument("--no-correct", dest="correct", action="store_false", help="keep the legs as detected")
     parser.add_argument("--fps", type=float, metavar="F", help="frame rate of an image folder (default 30)")

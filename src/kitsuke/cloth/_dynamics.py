@@ -414,8 +414,10 @@ def step(
     pairs = np.empty((len(x) * len(body.ends) if capsules else 0, 2), dtype=np.int64)
     lam_s = np.zeros(len(data.stretch_rest))
     lam_b = np.zeros(len(data.bend_rest))
-    # the farthest a capsule's end moves in a substep (any point of its axis moves no farther)
-    capsule_move = float(np.sqrt(((body.ends - body.previous) ** 2).sum(axis=2)).max()) / n_sub if capsules else 0.0
+    w_s = inv_mass[data.stretch_pairs[:, 0]] + inv_mass[data.stretch_pairs[:, 1]]
+    w_b = inv_mass[data.bend_pairs[:, 0]] + inv_mass[data.bend_pairs[:, 1]]
+    # how far each capsule's farther end moves in a substep (no point of its axis moves farther)
+    capsule_move = np.sqrt(((body.ends - body.previous) ** 2).sum(axis=2)).max(axis=1) / n_sub if capsules else None
     for s in range(n_sub):
         if held is not None:  # held vertices move with the skin, a substep's share of the step at a time
             t1 = (s + 1) / n_sub
@@ -425,9 +427,9 @@ def step(
         lam_b[:] = 0.0
         stretch, short = params.stretch_compliance / h**2, params.compression_compliance / h**2
         for _ in range(int(params.sweeps)):
-            K.solve_distances(p, inv_mass, data.stretch_pairs, data.stretch_rest, stretch, short, lam_s)
+            K.solve_distances(p, inv_mass, data.stretch_pairs, data.stretch_rest, w_s, stretch, short, lam_s)
         bend = params.bend_compliance / h**2
-        K.solve_distances(p, inv_mass, data.bend_pairs, data.bend_rest, bend, bend, lam_b)
+        K.solve_distances(p, inv_mass, data.bend_pairs, data.bend_rest, w_b, bend, bend, lam_b)
         t0, t1 = s / n_sub, (s + 1) / n_sub
         if capsules:  # what is fixed over the substep, once
             ends = (1.0 - t1) * body.previous + t1 * body.ends

@@ -49,18 +49,21 @@ def solve_distances(
     inv_mass: np.ndarray,
     pairs: np.ndarray,
     rest: np.ndarray,
+    weights: np.ndarray,
     alpha: float,
     alpha_short: float,
     lam: np.ndarray,
 ) -> None:
     """One Gauss-Seidel sweep of XPBD distance constraints |p_a − p_b| = rest, compliances already divided by h²:
     `alpha` for a pair longer than its rest length, `alpha_short` for a shorter one (cloth buckles rather than
-    resisting compression); `lam` (K,) holds each constraint's multiplier over the substep."""
+    resisting compression); `lam` (K,) holds each constraint's multiplier over the substep. weights (K,) : each
+    pair's inv_mass[a] + inv_mass[b], read in order (summed here from two scattered reads, ahead of the skip of
+    a pair that cannot move, the sweep took a third longer)."""
     for k in range(pairs.shape[0]):
-        a, b = pairs[k, 0], pairs[k, 1]
-        w = inv_mass[a] + inv_mass[b]
+        w = weights[k]
         if w == 0.0:
             continue
+        a, b = pairs[k, 0], pairs[k, 1]
         dx, dy, dz = p[a, 0] - p[b, 0], p[a, 1] - p[b, 1], p[a, 2] - p[b, 2]
         d = math.sqrt(dx * dx + dy * dy + dz * dz)
         if d < 1e-12:
@@ -87,14 +90,14 @@ def limit_strain(
     n = 0
     for k in range(pairs.shape[0]):
         a, b = pairs[k, 0], pairs[k, 1]
-        w = inv_mass[a] + inv_mass[b]
-        if w == 0.0:
-            continue
         dx, dy, dz = p[a, 0] - p[b, 0], p[a, 1] - p[b, 1], p[a, 2] - p[b, 2]
         d2 = dx * dx + dy * dy + dz * dz
         top = (1.0 + max_strain) * rest[k]
         bottom = (1.0 - max_squeeze) * rest[k]
-        if d2 < top * top and (d2 > bottom * bottom or d2 < 1e-24):  # most pairs: no square root
+        if d2 < top * top and (d2 > bottom * bottom or d2 < 1e-24):  # most pairs: no square root, no masses
+            continue
+        w = inv_mass[a] + inv_mass[b]
+        if w == 0.0:
             continue
         d = math.sqrt(d2)
         if d <= top and (d >= bottom or d < 1e-12):
@@ -111,12 +114,12 @@ def limit_strain(
 
 
 @njit(cache=True)
-def _capsule_boxes(ends: np.ndarray, radii: np.ndarray, reach: float) -> np.ndarray:
-    """(n, 6) each tapered capsule's bounding box (min xyz, max xyz) grown by `reach` metres."""
+def _capsule_boxes(ends: np.ndarray, radii: np.ndarray, reach: np.ndarray) -> np.ndarray:
+    """(n, 6) each tapered capsule's bounding box (min xyz, max xyz) grown by its `reach` (n,) metres."""
     n_caps = ends.shape[0]
     box = np.empty((n_caps, 6))
     for k in range(n_caps):
-        r = max(radii[k, 0], radii[k, 1]) + reach
+        r = max(radii[k, 0], radii[k, 1]) + reach[k]
         for c in range(3):
             box[k, c] = min(ends[k, 0, c], ends[k, 1, c]) - r
             box[k, 3 + c] = max(ends[k, 0, c], ends[k, 1, c]) + r
@@ -163,9 +166,10 @@ def _push_out_of_capsule(
     t, cx, cy, cz, ux, uy, uz, uu = _capsule_point(p, i, ends, k)
     r = radii[k, 0] + t * (radii[k, 1] - radii[k, 0]) + offset
     nx, ny, nz = p[i, 0] - cx, p[i, 1] - cy, p[i, 2] - cz
-    d = math.sqrt(nx * nx + ny * ny + nz * nz)
-    if d >= r:
+    d2 = nx * nx + ny * ny + nz * nz
+    if d2 >= r * r:  # most pairs: outside, no square root
         return False
+    d = math.sqrt(d2)
     if d < 1e-12:  # on the axis: out along a direction perpendicular to it
         if ux * ux < 0.8 * uu or uu == 0.0:
             nx, ny, nz = 0.0, uz, -uy  # u × x
@@ -201,12 +205,13 @@ def capsule_candidates(
     inv_mass: np.ndarray,
     ends: np.ndarray,
     radii: np.ndarray,
-    reach: float,
+    reach: np.ndarray,
     v: np.ndarray,
     lookahead: float,
     out: np.ndarray,
 ) -> int:
-    """The (vertex, capsule) pairs, vertex by vertex, whose free vertex lies within `reach` metres plus
+    """The (vertex, capsule) pairs, vertex by vertex, whose free vertex lies within the capsule's `reach` (n,)
+    metres plus
     `lookahead` seconds of its speed (v (V, 3), m/s) of the tapered capsule's surface, into out (V * n, 2) int64;
     returns how many. `collide_capsule_pairs` then tests only these: over the substeps they serve, the collision's
     rounds move the cloth far less than that."""
@@ -220,7 +225,7 @@ def capsule_candidates(
             if not _in_box(p, i, box, k, grow):
                 continue
             t, cx, cy, cz, _, _, _, _ = _capsule_point(p, i, ends, k)
-            r = radii[k, 0] + t * (radii[k, 1] - radii[k, 0]) + reach + grow
+            r = radii[k, 0] + t * (radii[k, 1] - radii[k, 0]) + reach[k] + grow
             if (p[i, 0] - cx) ** 2 + (p[i, 1] - cy) ** 2 + (p[i, 2] - cz) ** 2 < r * r:
                 out[n, 0], out[n, 1] = i, k
                 n += 1

@@ -8,8 +8,8 @@ Sources (all give a `PoseSequence` in the SPEC §2 joint set, metres, Y up, faci
 Filtering: `filter_poses` (One-Euro, `OneEuroConfig`).
 Correction: `correct_poses(poses, constraints)` → `Correction`; `correction_measures`, `check_invariants`.
 Constraints: `ConstraintTable`, `PairLimit`, `read_constraints`, `write_constraints`, `default_constraints` (the
-shipped table calibrated by simulation), `packaged_constraints` / `load_constraints` (shipped tables by name: "geometric",
-"calibrated" by simulation), `geometric_estimate`, `write_default_constraints` (the geometric table's file).
+shipped table calibrated by simulation), `packaged_constraints` / `load_constraints` (shipped tables by name:
+"calibrated", "geometric"), `geometric_estimate`, `write_default_constraints` (the geometric table's file).
 Outputs: `plot_distances` (PNG), `write_overlay_video` (H.264 mp4).
 
 mediapipe, OpenCV and matplotlib are imported only by the functions that need them.
