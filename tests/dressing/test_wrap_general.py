@@ -133,6 +133,39 @@ def test_a_piece_on_the_other_side_from_its_placement_is_not_a_garment(drawn_up)
         assert on_body_failures(g, _sphere(0.3)) == expected
 
 
+def test_a_piece_left_behind_when_the_strokes_turned_the_garment_is_named_with_the_turn():
+    """Two pieces placed at the front and at the left; the stroked one was worn at the back (the strokes turned
+    the garment round), the other stayed at the left: it should have turned to the right, and the message says
+    where the turned placement puts it, not where the untouched placement does (which would read "ended at the
+    left; its placement puts it at the left")."""
+    from types import SimpleNamespace
+
+    from kitsuke.dressing.outcome import wrong_side
+    from kitsuke.geometry import TriMesh
+
+    square = np.array([[-0.05, 0.0, 0.0], [0.05, 0.0, 0.0], [0.05, 0.1, 0.0], [-0.05, 0.1, 0.0]])
+    front = square + [0.0, 1.0, 0.3]
+    left = square[:, [2, 1, 0]] + [0.3, 1.0, 0.0]
+    back, right = front * [1.0, 1.0, -1.0], left * [-1.0, 1.0, 1.0]
+    pm = SimpleNamespace(
+        piece_names=["a", "b"], n_vertices=8, placed=np.ones(2, dtype=bool),
+        piece_vertices=np.array([[0, 4], [4, 8]]), positions_m=np.concatenate([front, left]),
+    )  # fmt: skip
+    body = TriMesh(np.array([[-0.2, 0.0, -0.1], [0.2, 0.0, -0.1], [0.0, 1.8, 0.1]]), np.array([[0, 1, 2]]))
+    faces = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
+
+    def worn(b: np.ndarray) -> SimpleNamespace:
+        return SimpleNamespace(
+            pattern_mesh=pm, pattern_vertex=np.arange(8), positions=np.concatenate([back, b]), faces=faces,
+            piece_faces=np.array([[0, 2], [2, 4]]), tracks=[SimpleNamespace(faces=np.array([0]))],
+        )  # fmt: skip
+
+    assert wrong_side(worn(right), body) == []  # turned with its stroked neighbour: fine
+    assert wrong_side(worn(left), body) == [
+        "piece b ended at the body's left; its placement, turned +180° as the stroked pieces were, puts it at the right"
+    ]
+
+
 def test_a_garment_on_the_body_reports_the_targets_it_misses(drawn_up):
     assert on_body_failures(drawn_up, _sphere(0.3)) == []
     strict = QualityTargets(max_strain=1e-4, stroke_residual_mm=0.1)

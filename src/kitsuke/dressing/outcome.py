@@ -41,6 +41,8 @@ SIDE_M = 0.05
 #: this, degrees (front against back is 180; a kimono's left front, placed open at the front left, crosses to
 #: the front right when worn: 90).
 WRONG_SIDE_DEG = 120.0
+#: A turn of the stroked pieces under this many degrees is not mentioned in `wrong_side`'s message.
+SAME_TURN_DEG = 20.0
 
 
 def _side(v: np.ndarray) -> str:
@@ -85,10 +87,14 @@ def wrong_side(garment, mesh: TriMesh) -> list[str]:
     for k, (placed, worn, t) in turn.items():
         off = abs(np.angle(np.exp(1j * (t - garment_turn))))
         if k not in stroked and off > np.radians(WRONG_SIDE_DEG):
-            out.append(
-                f"piece {pm.piece_names[k]} ended at the body's {_side(worn)}; its placement puts it at the "
-                f"{_side(placed)}"
-            )
+            where = f"its placement puts it at the {_side(placed)}"
+            if abs(garment_turn) > np.radians(SAME_TURN_DEG):
+                # the stroked pieces turned the garment: say where that turn puts this piece
+                a = np.arctan2(placed[0], placed[1]) + garment_turn
+                turned = _side(np.array([np.sin(a), np.cos(a)]))
+                by = f"{np.degrees(garment_turn):+.0f}°"
+                where = f"its placement, turned {by} as the stroked pieces were, puts it at the {turned}"
+            out.append(f"piece {pm.piece_names[k]} ended at the body's {_side(worn)}; {where}")
     return out
 
 
