@@ -30,6 +30,18 @@ class InputError(KitsukeError, ValueError):
         super().__init__(f"{self.path}: {message}" if self.path else message)
 
 
+def require_non_negative(settings: object, label: str, *names: str) -> None:
+    """InputError unless each attribute `names` of `settings` is a finite number >= 0 (settings groups check
+    their constants with it: "dynamics parameter damping must be a finite number >= 0, got nan")."""
+    import math
+    from numbers import Real
+
+    for name in names:
+        v = getattr(settings, name)
+        if isinstance(v, bool) or not isinstance(v, Real) or not (math.isfinite(v) and v >= 0):
+            raise InputError(f"{label} {name} must be a finite number >= 0, got {v!r}")
+
+
 class ComputationError(KitsukeError, RuntimeError):
     """A computation that gave no usable result: it diverged, went non-finite, or its result is not what it
     should be (a garment that is not on the body).

@@ -76,6 +76,18 @@ def test_a_leg_shows_where_the_cloth_ring_has_a_gap_over_it():
     assert uncovered(leg, normals, np.zeros((0, 2)), 0.03).all()
 
 
+@pytest.mark.parametrize(
+    "bad", [{"hem_m": -0.01}, {"band_m": float("nan")}, {"torn_strain": float("inf")}, {"uncovered_fraction": 1.5}]
+)
+def test_break_thresholds_refuse_what_cannot_be_a_threshold(bad):
+    from kitsuke.errors import InputError
+    from kitsuke.tryon.calibrate import BreakThresholds
+
+    with pytest.raises(InputError, match="break threshold"):
+        BreakThresholds(**bad)
+    assert BreakThresholds().hem_m == 0.08  # the defaults pass
+
+
 def test_cross_section_area_of_a_tube():
     a = np.linspace(0, 2 * np.pi, 200, endpoint=False)
     tube = np.concatenate([np.column_stack([0.15 * np.cos(a), np.full(200, y), 0.1 * np.sin(a)]) for y in (0.4, 0.5)])

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ComputationError, InputError
+from ..errors import ComputationError, InputError, require_non_negative
 from . import _dynamics_kernels as K
 from ._collide import BodyCollider, collide, track
 from ._model import ClothModel, ClothState
@@ -93,7 +93,9 @@ class DynamicsParams:
     max_speed_m_s: float = 50.0
 
     def __post_init__(self) -> None:
-        for name in (
+        require_non_negative(
+            self,
+            "dynamics parameter",
             "gravity",
             "density_kg_m2",
             "stretch_compliance",
@@ -102,10 +104,7 @@ class DynamicsParams:
             "max_strain",
             "max_squeeze",
             "damping",
-        ):
-            v = getattr(self, name)
-            if not (np.isfinite(v) and v >= 0):
-                raise InputError(f"dynamics parameter {name} must be a finite number >= 0, got {v!r}")
+        )
         if not self.density_kg_m2 > 0:
             raise InputError("dynamics parameter density_kg_m2 must be positive")
         for name in ("substeps", "sweeps", "contact_rounds"):

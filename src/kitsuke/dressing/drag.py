@@ -83,7 +83,7 @@ from ..cloth import (
     relax,
     track,
 )
-from ..errors import InputError
+from ..errors import InputError, require_non_negative
 from ..geometry import TriMesh
 from ..metrics import QualityReport, quality_report, strain
 from . import _drag_kernels as K
@@ -246,8 +246,7 @@ class DragParams:
             and list(give) == sorted(give)
         ):
             raise InputError(f"drag parameter release_give_m must be a tuple of increasing metres > 0, got {give!r}")
-        if not (math.isfinite(self.contact_weight) and self.contact_weight >= 0):
-            raise InputError(f"drag parameter contact_weight must be a finite number >= 0, got {self.contact_weight!r}")
+        require_non_negative(self, "drag parameter", "contact_weight")
         if not (0 <= self.near_m < self.far_m and math.isfinite(self.far_m)):
             raise InputError("drag parameters need 0 <= near_m < far_m (metres)")
         if self.falloff not in ("smooth", "linear"):

@@ -12,10 +12,8 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field, fields
 
-import numpy as np
-
 from ..cloth import ClothParams
-from ..errors import InputError
+from ..errors import InputError, require_non_negative
 from ._polish_step import PolishSettings
 
 
@@ -83,8 +81,7 @@ class GrowSettings:
         _at_least(self, 0, "iterations")
         if not (self.lift_m >= 0 and self.hang_clearance_m >= 0):
             raise InputError("GrowSettings.lift_m and GrowSettings.hang_clearance_m must be >= 0 (metres)")
-        if not (np.isfinite(self.hang) and self.hang >= 0 and np.isfinite(self.skirt_hang) and self.skirt_hang >= 0):
-            raise InputError("GrowSettings.hang and GrowSettings.skirt_hang must be finite and >= 0")
+        require_non_negative(self, "GrowSettings", "hang", "skirt_hang")
         if self.bridge_legs not in (None, True, False):
             raise InputError(f"GrowSettings.bridge_legs must be None, True or False, got {self.bridge_legs!r}")
 
@@ -186,9 +183,7 @@ class DrapeSettings:
     damping: float = 2.0
 
     def __post_init__(self) -> None:
-        values = (self.seconds, self.hold_m, self.hanging_m, self.damping)
-        if not all(np.isfinite(v) and v >= 0 for v in values):
-            raise InputError("DrapeSettings.seconds, .hold_m, .hanging_m and .damping must be finite and >= 0")
+        require_non_negative(self, "DrapeSettings", "seconds", "hold_m", "hanging_m", "damping")
         if not 0 <= self.min_hanging <= 1:
             raise InputError("DrapeSettings.min_hanging must be a share in [0, 1]")
 

@@ -30,12 +30,12 @@ from __future__ import annotations
 import math
 import time
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
 from ..body.skinning import forward_kinematics, rotation_between
-from ..errors import ComputationError, InputError
+from ..errors import ComputationError, InputError, require_non_negative
 from ..skeleton import INDEX, descendants
 from .simulate import KimonoSimulator, SimulationSettings
 
@@ -62,6 +62,11 @@ class BreakThresholds:
     uncovered_fraction: float = 0.05
     inside_m: float = 0.005
     inside_fraction: float = 0.005
+
+    def __post_init__(self) -> None:
+        require_non_negative(self, "break threshold", *(f.name for f in fields(self)))
+        if not all(getattr(self, name) <= 1.0 for name in ("torn_fraction", "uncovered_fraction", "inside_fraction")):
+            raise InputError("break thresholds torn_fraction, uncovered_fraction and inside_fraction are shares <= 1")
 
 
 @dataclass(frozen=True)
