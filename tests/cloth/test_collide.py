@@ -239,6 +239,31 @@ def test_sheet_partly_inside_the_default_body_ends_outside(body, body_collider):
     assert pen.count == 0 and pen.deepest_mm <= 2.0
 
 
+def test_collide_told_what_moved_matches_a_full_collision(body, body_collider, rng):
+    """`collide(moved=)` (what a strain limit's sweeps pass): told which vertices moved since the last collision
+    (those it pushed among them), it ends with the positions and tracked contacts of a full collision, capsules
+    included."""
+    uv, faces = grid_sheet(15, 15, 0.02)
+    model = ClothModel.from_flat(faces, uv)
+    pos = np.c_[uv - 0.14, np.zeros(len(uv))] + [0.0, 1.0, 0.0]
+    v = body.mesh.vertices
+    pos[:, 2] = v[(np.abs(v[:, 1] - 1.0) < 0.01) & (np.abs(v[:, 0]) < 0.15), 2].max() + 0.002
+    state = ClothState.new(model, pos)
+    collide(model, state, body_collider)
+    moved = (state.positions != pos).any(axis=1)  # what the collision pushed, it tracks again next time
+    assert 0 < moved.sum() < model.n_vertices
+    shaken = rng.choice(model.n_vertices, 20, replace=False)
+    state.positions[shaken] += rng.normal(0.0, 0.01, (20, 3))  # some into the body, some away
+    moved[shaken] = True
+    full, told = state.copy(), state.copy()
+    collide(model, full, body_collider)
+    stats = collide(model, told, body_collider, moved=moved)
+    assert stats.pushed > 0
+    np.testing.assert_array_equal(told.positions, full.positions)
+    for name in ("face", "distance", "point"):
+        np.testing.assert_array_equal(getattr(told.contacts, name), getattr(full.contacts, name))
+
+
 def test_floor_keeps_cloth_above_the_ground_and_pins_still(sphere):
     collider = BodyCollider.from_mesh(sphere, floor_y=-0.2)
     pts = np.array(

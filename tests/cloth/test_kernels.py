@@ -220,6 +220,51 @@ def test_project_lengths_with_a_band_limits_strain_only(crumpled, rng):
     np.testing.assert_array_equal(kept, rest_pos)
 
 
+def test_stamped_sweeps_skip_only_what_cannot_change(crumpled, rng):
+    """`project_band` and the tethers with stamps (what `restore_lengths` runs for a strain limit) give the plain
+    sweeps' positions and worst errors bit for bit, over forward and backward sweeps with some vertices moved from
+    outside between them (a collision), while skipping most of the work once the cloth is nearly within band."""
+    model, pos = crumpled
+    movable = rng.random(model.n_vertices) > 0.2
+    forward = rng.permutation(model.n_edges).astype(np.int64)
+    backward = np.ascontiguousarray(forward[::-1])
+    faces = rng.integers(0, model.n_faces, 30)
+    line = pos.mean(axis=0) + rng.normal(0.0, 0.03, (5, 3))
+    groups = [(faces, rng.dirichlet(np.ones(3), 30), line)]
+    plain_t, stamped_t = (Tethers.from_polylines(groups, model.faces, reach_m=0.02) for _ in range(2))
+    plain, stamped = pos.copy(), pos.copy()
+    moved, seen = np.zeros(model.n_vertices, np.int64), np.full(model.n_edges, -1, np.int64)
+    clock = np.zeros(1, np.int64)
+    stamps = (moved, np.full(len(stamped_t), -1, np.int64), clock)
+    for sweep in range(40):
+        order = backward if sweep % 2 else forward
+        worst = K.project_lengths(plain, model.edges, model.rest_lengths, movable, order, 1.0, 0.05)
+        met = clock[0]
+        got = K.project_band(stamped, model.edges, model.rest_lengths, movable, order, 0.05, moved, seen, clock)
+        assert got == worst
+        assert stamped_t.project(stamped, movable, stamps) == plain_t.project(plain, movable)
+        np.testing.assert_array_equal(stamped, plain)
+        if sweep % 8 == 7:  # a collision pushes a few vertices: they are met again
+            push = np.flatnonzero(movable)[rng.integers(0, movable.sum(), 5)]
+            shift = rng.normal(0.0, 0.002, (5, 3))
+            plain[push] += shift
+            stamped[push] += shift
+            clock[0] += 1
+            moved[push] = clock[0]
+    # Cloth within its band but for one vertex: after the first sweep meets every edge, the next meets only the
+    # edges round what moved.
+    flat = np.zeros((model.n_vertices, 3))
+    flat[model.faces.reshape(-1), :2] = model.rest_corners.reshape(-1, 2) * 1.03
+    flat[0] += 0.01
+    moved[:], seen[:], clock[0] = 0, -1, 0
+    K.project_band(flat, model.edges, model.rest_lengths, np.ones(model.n_vertices, bool), forward, 0.05, moved,
+                   seen, clock)  # fmt: skip
+    met = clock[0]
+    K.project_band(flat, model.edges, model.rest_lengths, np.ones(model.n_vertices, bool), backward, 0.05, moved,
+                   seen, clock)  # fmt: skip
+    assert 0 < (seen > met).sum() < model.n_edges / 3
+
+
 def test_project_tethers_matches_reference_and_moves_only_what_is_out_of_reach(crumpled, rng):
     """Points on random triangles tethered to two random polylines (through `Tethers.project`, so with its
     nearest-segment cache): the kernel moves what the numpy reference

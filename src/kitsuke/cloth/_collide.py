@@ -465,11 +465,18 @@ def keep_layers(model: ClothModel, state: ClothState, movable: np.ndarray | None
     return moved
 
 
-def collide(model: ClothModel, state: ClothState, collider: BodyCollider) -> CollisionStats:
+def collide(
+    model: ClothModel, state: ClothState, collider: BodyCollider, *, moved: np.ndarray | None = None
+) -> CollisionStats:
     """One collision update (in place): layered cloth restores its layer order (`keep_layers`); capsules push
     vertices, then edges, out; the nearest body points are tracked; vertices closer than
     `params.contact_offset_m` (or inside) move out along the body normal. Pinned vertices and vertices without an
     active triangle never move.
+
+    moved : (V,) bool, the vertices that moved since the last collision on this (still) body, those it pushed
+    included, or None (all may have). The others keep their tracked contacts and are not tested again: each lay
+    outside when it was last tracked and would walk to the same body point from there, so the result is a full
+    collision's to the last bit. The layers and capsules test everything, and what they move is tracked.
     """
     if not isinstance(collider, BodyCollider):
         raise InputError("collider must be a BodyCollider")
@@ -479,6 +486,8 @@ def collide(model: ClothModel, state: ClothState, collider: BodyCollider) -> Col
     w = _buffers(state)
     movable = np.logical_and(act, ~state.pinned, out=w["movable"])
     pos = state.positions
+    shoved = model.face_layer is not None or len(collider.capsule_ends)
+    before = pos.copy() if moved is not None and shoved else None
     # Layers first: an inner layer pushed into the body comes back out below, and the outer one follows next time.
     keep_layers(model, state, movable)
     if len(collider.capsule_ends):
@@ -489,6 +498,10 @@ def collide(model: ClothModel, state: ClothState, collider: BodyCollider) -> Col
             K.capsule_edges(
                 pos, active_edges(model, state), movable, collider.capsule_ends, collider.capsule_radii, w["near"]
             )
+    if moved is not None:
+        recent = moved if before is None else moved | (pos != before).any(axis=1)
+        act = act & recent
+        movable = movable & recent
     searches = track(model, state, collider, active=act)
     c = state.contacts
     pushed, deepest = K.push_out(pos, movable, p.contact_offset_m, c.face, c.normal, c.distance)

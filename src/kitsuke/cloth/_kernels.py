@@ -372,6 +372,58 @@ def project_lengths(pos, edges, rest_lengths, movable, order, omega, band):
     return worst
 
 
+@njit(cache=True)
+def project_band(pos, edges, rest_lengths, movable, order, band, moved, seen, clock):
+    """`project_lengths` with omega 1 and a band > 0 (a strain limit), skipping every edge whose ends have not moved
+    since it was last met: it was within its band then and still is, so the sweep is the same to the last bit.
+    A strain limit moves a few edges of thousands per sweep, so most sweeps skip most of them.
+
+    moved (V,) int64: when each vertex last moved; seen (E,) int64: when each edge was last met (-1: never);
+    clock (1,) int64: the time now. All in place; a vertex moved outside the kernels (collision) must get
+    moved[v] = clock[0] + 1 and the clock that value.
+    """
+    worst = 0.0
+    t = clock[0]
+    for o in range(len(order)):
+        e = order[o]
+        a, b = edges[e, 0], edges[e, 1]
+        if moved[a] <= seen[e] and moved[b] <= seen[e]:
+            continue
+        t += 1
+        seen[e] = t
+        wa = 1.0 if movable[a] else 0.0
+        wb = 1.0 if movable[b] else 0.0
+        if wa + wb == 0.0:
+            continue
+        dx, dy, dz = pos[b, 0] - pos[a, 0], pos[b, 1] - pos[a, 1], pos[b, 2] - pos[a, 2]
+        d = math.sqrt(dx * dx + dy * dy + dz * dz)
+        if d * d < TINY2:
+            continue
+        err = d - rest_lengths[e]
+        slack = band * rest_lengths[e]
+        if err > slack:
+            err -= slack
+        elif err < -slack:
+            err += slack
+        else:
+            continue
+        worst = max(worst, abs(err))
+        f = err / (d * (wa + wb))
+        t += 1
+        if wa > 0.0:
+            pos[a, 0] += f * dx
+            pos[a, 1] += f * dy
+            pos[a, 2] += f * dz
+            moved[a] = t
+        if wb > 0.0:
+            pos[b, 0] -= f * dx
+            pos[b, 1] -= f * dy
+            pos[b, 2] -= f * dz
+            moved[b] = t
+    clock[0] = t
+    return worst
+
+
 #: Segments either side of a tether point's last nearest one that `project_tethers` searches while its cache holds.
 TETHER_WINDOW = 4
 
@@ -393,7 +445,7 @@ def _segment_nearest(px, py, pz, line_points, j, last):
 
 
 @njit(cache=True)
-def project_tethers(pos, tri, bary, movable, line_points, line_start, line_of, reach, seg, second, snap):
+def project_tethers(pos, tri, bary, movable, line_points, line_start, line_of, reach, seg, second, snap, stamps):
     """One sweep of tethers (in place on pos (V, 3)): each cloth point p = sum_k bary[i, k] * pos[tri[i, k]]
     farther than `reach` metres from its polyline (points line_points[line_start[l]:line_start[l + 1]], l =
     line_of[i]) is pulled straight towards the polyline's nearest point until it is `reach` away, its vertices
@@ -408,11 +460,23 @@ def project_tethers(pos, tri, bary, movable, line_points, line_start, line_of, r
     away now: while the best segment of that window is nearer than that, it is the nearest and only the window
     is searched (exact, not a heuristic; the cloth moves far less per sweep than that). Same result as a full
     search every time.
+
+    stamps : None, or (moved (V,) int64, seen (n,) int64, clock (1,) int64) as in `project_band`: a point none
+    of whose vertices moved since it was last met is skipped (it was within reach then, or pulled to it).
     """
     worst = 0.0
+    t = 0
+    if stamps is not None:
+        t = stamps[2][0]
     for i in range(tri.shape[0]):
         if not (movable[tri[i, 0]] and movable[tri[i, 1]] and movable[tri[i, 2]]):
             continue
+        if stamps is not None:
+            vmoved, seen = stamps[0], stamps[1]
+            if vmoved[tri[i, 0]] <= seen[i] and vmoved[tri[i, 1]] <= seen[i] and vmoved[tri[i, 2]] <= seen[i]:
+                continue
+            t += 1
+            seen[i] = t
         px = py = pz = 0.0
         for k in range(3):
             v = tri[i, k]
@@ -452,12 +516,17 @@ def project_tethers(pos, tri, bary, movable, line_points, line_start, line_of, r
         worst = max(worst, over)
         w2 = bary[i, 0] * bary[i, 0] + bary[i, 1] * bary[i, 1] + bary[i, 2] * bary[i, 2]
         f = over / (d * w2)
+        t += 1
         for k in range(3):
             v = tri[i, k]
             s = f * bary[i, k]
             pos[v, 0] += s * (qx - px)
             pos[v, 1] += s * (qy - py)
             pos[v, 2] += s * (qz - pz)
+            if stamps is not None:
+                stamps[0][v] = t
+    if stamps is not None:
+        stamps[2][0] = t
     return worst
 
 

@@ -164,6 +164,14 @@ def _sweep(
         state.contacts.forget()
         stats.searches += collide(model, state, collider).searches
     accelerate = chebyshev_rho is not None and sweeps > PLAIN_FINISH + CHEBYSHEV_DELAY
+    # A strain limit (band, plain sweeps) meets only the edges and tether points whose vertices moved since they
+    # were last met (`K.project_band`): the same sweeps, most of each skipped.
+    stamps = None
+    if band > 0.0 and not accelerate and over_relaxation == 1.0:
+        clock = np.zeros(1, dtype=np.int64)
+        moved, seen = np.zeros(model.n_vertices, dtype=np.int64), np.full(model.n_edges, -1, dtype=np.int64)
+        stamps = (moved, np.full(len(tethers) if tethers is not None else 0, -1, dtype=np.int64), clock)
+        collided = -1  # the clock at the last collision (none yet: every vertex counts as moved)
     if accelerate:
         older, start = pos.copy(), np.empty_like(pos)  # the iterates one and two sweeps back
         rho2, weight = chebyshev_rho * chebyshev_rho, 1.0
@@ -172,19 +180,19 @@ def _sweep(
         plain = s >= sweeps - PLAIN_FINISH
         if accelerate:
             np.copyto(start, pos)
-        stats.worst_error_m = float(
-            K.project_lengths(
-                pos,
-                model.edges,
-                model.rest_lengths,
-                movable,
-                backward if s % 2 else forward,
-                1.0 if plain else over_relaxation,
-                band,
+        order = backward if s % 2 else forward
+        if stamps is not None:
+            stats.worst_error_m = float(
+                K.project_band(pos, model.edges, model.rest_lengths, movable, order, band, moved, seen, clock)
             )
-        )
+        else:
+            stats.worst_error_m = float(
+                K.project_lengths(
+                    pos, model.edges, model.rest_lengths, movable, order, 1.0 if plain else over_relaxation, band
+                )
+            )
         if tethers is not None and len(tethers):
-            stats.worst_tether_m = tethers.project(pos, movable)
+            stats.worst_tether_m = tethers.project(pos, movable, stamps)
         if accelerate and not plain and s >= CHEBYSHEV_DELAY:
             weight = 2.0 / (2.0 - rho2) if s == CHEBYSHEV_DELAY else 4.0 / (4.0 - rho2 * weight)
             pos -= older  # pinned and inactive vertices: q_sweep = q_(k-1), so they stay where they are
@@ -201,9 +209,17 @@ def _sweep(
             return None
         last = s == sweeps - 1 or max(stats.worst_error_m, stats.worst_tether_m) <= tolerance_m
         if collider is not None and ((s + 1) % collide_every == 0 or last):
-            if last and not search_first:
+            forgot = last and not search_first
+            if forgot:
                 state.contacts.forget()
-            stats.searches += collide(model, state, collider).searches
+            if stamps is None or forgot:
+                stats.searches += collide(model, state, collider).searches
+            else:  # only what moved since the last collision is tracked; what the collision moves is met again
+                before = pos.copy()
+                stats.searches += collide(model, state, collider, moved=moved > collided).searches
+                clock[0] += 1
+                moved[(pos != before).any(axis=1)] = clock[0]
+                collided = clock[0] - 1
         if last:
             break
     if not _bounded(pos, origin):

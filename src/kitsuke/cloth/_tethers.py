@@ -158,9 +158,11 @@ class Tethers:
             out[sel] = q[np.arange(len(sel)), best]
         return out
 
-    def project(self, positions: np.ndarray, movable: np.ndarray) -> float:
+    def project(self, positions: np.ndarray, movable: np.ndarray, stamps: tuple | None = None) -> float:
         """One sweep (in place on positions (V, 3)): every point beyond its reach pulled back to it, its vertices
-        moving only where `movable` (V,) bool is set on all three. Returns the farthest beyond reach met, metres."""
+        moving only where `movable` (V,) bool is set on all three. Returns the farthest beyond reach met, metres.
+        stamps : (moved (V,), seen (n,), clock (1,)) int64, to skip the points whose vertices have not moved since
+        they were last met (`_kernels.project_band`), or None."""
         if not len(self):
             return 0.0
         return float(
@@ -176,6 +178,7 @@ class Tethers:
                 self._seg,
                 self._second,
                 self._snap,
+                stamps,
             )
         )
 
