@@ -5,9 +5,10 @@ as a hand would draw them, dressed on GarmentCode's mean_all body.
     python benchmarks/bench_corpus.py --seeds 101 --batch local --workers 2   # the same jobs through kitsuke.batch
 
 For each seed, `../shared/tools/garment_sampler/sample.py` draws `--n` designs (only those whose outlines do not
-cross); each design's strokes come from `kitsuke.dressing.suggest_strokes` and are then perturbed
-(`kitsuke.dressing.perturb_strokes`: length x0.7-1.3, moved up to 2 cm, drawn backwards half the time, one
-stroke left out). Each is dressed with `wrap` and sorted into:
+cross; the sampler needs `pip install svgpathtools svgwrite pyyaml psutil cairosvg matplotlib`); each design's
+strokes come from `kitsuke.dressing.suggest_strokes` and are then perturbed (`kitsuke.dressing.perturb_strokes`:
+length x0.7-1.3, moved up to 2 cm, drawn backwards half the time, one stroke left out).
+Each is dressed with `wrap` and sorted into:
 
 - within targets: `kitsuke.metrics.QualityTargets.robust()` (nothing deeper than 2 mm inside, mean strain <= 1 %, max
   strain <= 10 %, seams closed, no inverted triangle, every stroke within 1 cm of where it was drawn);
@@ -45,6 +46,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLER = ROOT.parent / "shared" / "tools" / "garment_sampler" / "sample.py"
 BODY = ROOT / "tests" / "data" / "bodies" / "mean_all.obj"
+#: What GarmentCode's sampler imports beyond kitsuke's own dependencies.
+SAMPLER_NEEDS = "svgpathtools svgwrite pyyaml psutil cairosvg matplotlib"
 
 
 def rng_of(path: Path) -> np.random.Generator:
@@ -58,11 +61,12 @@ def sample(seed: int, n: int, out: Path, sampler: Path = SAMPLER) -> list[Path]:
     if not sampler.exists():
         sys.exit(f"sampling designs needs GarmentCode's sampler at {sampler} (--sampler)")
     out.mkdir(parents=True, exist_ok=True)
-    subprocess.run(
-        [sys.executable, str(sampler), str(out), "--n", str(n), "--seed", str(seed)],
-        check=True,
-        capture_output=True,
+    done = subprocess.run(
+        [sys.executable, str(sampler), str(out), "--n", str(n), "--seed", str(seed)], capture_output=True, text=True
     )
+    if done.returncode:
+        last = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
+        sys.exit(f"GarmentCode's sampler failed: {last} (it needs: pip install {SAMPLER_NEEDS})")
     return sorted(out.glob("*_specification.json"))
 
 
