@@ -73,6 +73,7 @@ from ..geometry import TriMesh
 from ..metrics import QualityReport, QualityTargets, quality_report, strain
 from ..pattern import Pattern, PatternMesh, face_layers, mesh_pattern
 from ._bridge import bridged, spans_legs
+from ._gather import Gather, gathered_rest
 from ._mend import MendStats, mend_tears
 from ._place import StrokeTrack, place_strokes
 from ._polish_step import polish_step
@@ -119,6 +120,8 @@ class DressedGarment:
         distance of its pattern stroke (on the garment) to its body stroke after the settle.
     stroke_length_ratio : (S,) body stroke length / pattern stroke length (the cloth keeps its own length).
     loose_strokes : ids of the strokes not held to their body strokes after the settle (`TetherSettings.slack_m`).
+    gathers : the seams whose longer side was gathered onto the shorter (`WrapParams.gather`): the model's rest
+        shape is gathered there, and strain is measured against it.
     rings : growth rings. mend : what `_mend.mend_tears` did after the close (rounds, torn edges before and
         after). polished : the polish's result was kept (`PolishSettings.rounds`). timings : seconds per step
         ("mesh", "resolve", "place", "grow", "close", "settle", "finish", "untangle", "polish", "wrap" = all of
@@ -141,6 +144,7 @@ class DressedGarment:
     stroke_length_ratio: np.ndarray = field(default_factory=lambda: np.zeros(0))
     tracks: list[StrokeTrack] = field(default_factory=list, repr=False)
     loose_strokes: list[int] = field(default_factory=list)
+    gathers: list[Gather] = field(default_factory=list)
     rings: int = 0
     mend: MendStats = field(default_factory=MendStats)
     polished: bool = False
@@ -170,6 +174,7 @@ class DressedGarment:
             "mend": dataclasses.asdict(self.mend),
             "polished": self.polished,
             "loose_strokes": list(self.loose_strokes),
+            "gathered_seams": [dataclasses.asdict(g) | {"ratio": round(g.ratio, 4)} for g in self.gathers],
             "timings_s": {k: round(v, 4) for k, v in self.timings.items()},
             "strokes": [
                 {
@@ -311,8 +316,11 @@ def wrap(
     placement = place_strokes(pm, welded, strokes, surface, collider, lift_m=p.grow.lift_m, placements=placements)
     grow_params = dataclasses.replace(p.cloth, gravity_step_m=0.0)
     layer = face_layers(pm.layers, pm.piece_names, welded.piece_faces, welded.rest_corners * 100.0)
+    # Seams of unequal sides gather the longer one: the model's rest shape (its uv stays the pattern's).
+    g = p.gather
+    rest, gathers = gathered_rest(pm, welded, min_difference=g.min_difference, min_cm=g.min_cm, depth_cm=g.depth_cm)
     model = ClothModel.from_corners(
-        welded.faces, welded.rest_corners, n_vertices=welded.n_vertices, params=grow_params, face_layer=layer
+        welded.faces, rest, n_vertices=welded.n_vertices, params=grow_params, face_layer=layer
     )
     state = ClothState.new(model, placement.positions, face_active=placement.seed_faces)
     seed_pins = placement.placed.copy()  # the stroke triangles' vertices, held while the garment grows
@@ -447,6 +455,7 @@ def wrap(
         stroke_length_ratio=ratio,
         tracks=tracks,
         loose_strokes=[tr.id for tr, far in zip(placement.tracks, loose, strict=True) if far],
+        gathers=gathers,
         rings=grown["rings"],
         polished=done.polished,
         mend=mended,

@@ -48,6 +48,25 @@ def _of_kind(name: str, default: object, value: object) -> object:
 
 
 @dataclass(frozen=True)
+class GatherSettings:
+    """Before growth: a seam whose sides differ in length gathers its longer side (`kitsuke.dressing._gather`).
+
+    min_difference, min_cm : sides differing by more than this share of the longer and by more than this many cm
+        are gathered; others share their difference between the two sides (a 1.5 mm stitch against a 0.7 mm one
+        is a rounding of the design, not a gather: gathered, it shrank the bodice round it by half and tore it).
+    depth_cm : how far into the gathered piece its rest shape is shortened along the seam, easing from the seam's
+        ratio to none, cm; 0 gathers nothing.
+    """
+
+    min_difference: float = 0.03
+    min_cm: float = 1.0
+    depth_cm: float = 8.0
+
+    def __post_init__(self) -> None:
+        require_non_negative(self, "GatherSettings", "min_difference", "min_cm", "depth_cm")
+
+
+@dataclass(frozen=True)
 class GrowSettings:
     """Steps 1-2, placing the stroke triangles and growing the rest of the garment from them.
 
@@ -267,7 +286,7 @@ class WrapParams:
     """Settings of `wrap`, one group per stage (see each group's docstring).
 
     edge_length_cm : target triangle edge length when `wrap` meshes a Pattern itself, cm.
-    grow, close, settle, drape, lengths, tethers, untangle, polish : the stages' settings. The polish (step 7;
+    gather, grow, close, settle, drape, lengths, tethers, untangle, polish : the stages' settings. The polish (step 7;
         kept only where it is better, `_polish_step`) runs `polish.passes` passes while the max strain is over 5 %;
         its untangle follows `untangle`.
     cloth : ClothParams of the Jacobi relaxation (growth, the settle), the untangle and the returned model (a later
@@ -276,6 +295,7 @@ class WrapParams:
     """
 
     edge_length_cm: float = 1.5
+    gather: GatherSettings = field(default_factory=GatherSettings)
     grow: GrowSettings = field(default_factory=GrowSettings)
     close: CloseSettings = field(default_factory=CloseSettings)
     settle: SettleSettings = field(default_factory=SettleSettings)
@@ -290,6 +310,7 @@ class WrapParams:
         if not self.edge_length_cm > 0:
             raise InputError("WrapParams.edge_length_cm must be > 0 (cm)")
         kinds = {
+            "gather": GatherSettings,
             "grow": GrowSettings,
             "close": CloseSettings,
             "settle": SettleSettings,

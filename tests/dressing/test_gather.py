@@ -1,0 +1,71 @@
+"""Gathered seams: a seam of unequal sides gathers the longer side in the cloth model's rest shape."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from kitsuke.cloth import ClothModel
+from kitsuke.dressing._gather import gathered_rest
+from kitsuke.dressing._weld import weld
+from kitsuke.pattern import Pattern, Piece, mesh_pattern
+from kitsuke.pattern._types import EdgeRef, Seam
+
+
+def _band_on_panel(band_cm: float, panel_cm: float) -> Pattern:
+    """A 6 cm band whose lower edge (`band_cm` long) is sewn to the top of a 30 cm tall panel (`panel_cm` wide)."""
+    band = Piece("band", np.array([[0.0, 0.0], [band_cm, 0.0], [band_cm, 6.0], [0.0, 6.0]]))
+    panel = Piece("panel", np.array([[0.0, 0.0], [panel_cm, 0.0], [panel_cm, 30.0], [0.0, 30.0]]))
+    seams = [Seam(EdgeRef("band", 0), EdgeRef("panel", 2))]
+    return Pattern("gathered", [band, panel], seams)
+
+
+def _model(pattern: Pattern, **settings):
+    pm = mesh_pattern(pattern, edge_length=1.5)
+    welded = weld(pm)
+    rest, gathers = gathered_rest(pm, welded, **({"min_difference": 0.03, "min_cm": 1.0, "depth_cm": 8.0} | settings))
+    return pm, welded, ClothModel.from_corners(welded.faces, rest, n_vertices=welded.n_vertices), gathers
+
+
+def _seam_rest_length(pm, welded, model) -> float:
+    """The model's rest length along the sewn seam, cm."""
+    return _chain_rest_length(welded.vertex_of[pm.seam_vertices[0][:, 0]], model)
+
+
+def _edge_rest_length(pm, welded, model, edge: EdgeRef) -> float:
+    """The model's rest length along a piece's edge, cm."""
+    return _chain_rest_length(welded.vertex_of[pm.edge_vertices[edge]], model)
+
+
+def _chain_rest_length(chain, model) -> float:
+    edges = {tuple(sorted(e)): i for i, e in enumerate(model.edges.tolist())}
+    return 100.0 * sum(model.rest_lengths[edges[tuple(sorted(p))]] for p in zip(chain[:-1], chain[1:], strict=True))
+
+
+def test_the_longer_side_is_gathered_onto_the_shorter():
+    """A 30 cm band on a 20 cm panel: the seam's rest length is the panel's 20 cm (sewn as it is, it was the mean,
+    25 cm: both sides strained 20-25 %), the band's far edge eases back towards its own length, and the panel,
+    the shorter side, keeps its shape."""
+    pattern = _band_on_panel(30.0, 20.0)
+    pm, welded, model, gathers = _model(pattern)
+    assert [(g.piece, round(g.ratio, 3)) for g in gathers] == [("band", pytest.approx(0.667, abs=1e-3))]
+    assert _seam_rest_length(pm, welded, model) == pytest.approx(20.0, rel=0.02)
+    plain = ClothModel.from_corners(welded.faces, welded.rest_corners, n_vertices=welded.n_vertices)
+    assert _seam_rest_length(pm, welded, plain) == pytest.approx(25.0, rel=0.02)
+    panel = slice(*welded.piece_faces[1])
+    np.testing.assert_array_equal(model.rest_corners[panel], plain.rest_corners[panel])
+    # the band's top edge, 6 cm from the seam: shortened less than the seam (smoothstep of 6/8: to 0.92 of it)
+    assert 25.0 < _edge_rest_length(pm, welded, model, EdgeRef("band", 2)) < 29.5
+    # every rest triangle keeps its area sign and a sensible shape
+    assert (model.rest_areas > 0.2 * plain.rest_areas).all()
+
+
+def test_nearly_equal_or_tiny_differences_are_not_gathered():
+    """A difference under the share (2 % < 3 %) or under the centimetre (a rounding of the design) is shared
+    between the sides as before; depth 0 gathers nothing."""
+    for band, panel in ((20.4, 20.0), (5.9, 5.0)):
+        _, welded, model, gathers = _model(_band_on_panel(band, panel))
+        assert gathers == []
+        np.testing.assert_array_equal(model.rest_corners, welded.rest_corners)
+    _, welded, model, gathers = _model(_band_on_panel(30.0, 20.0), depth_cm=0.0)
+    assert gathers == [] and np.array_equal(model.rest_corners, welded.rest_corners)
