@@ -69,3 +69,19 @@ def test_nearly_equal_or_tiny_differences_are_not_gathered():
         np.testing.assert_array_equal(model.rest_corners, welded.rest_corners)
     _, welded, model, gathers = _model(_band_on_panel(30.0, 20.0), depth_cm=0.0)
     assert gathers == [] and np.array_equal(model.rest_corners, welded.rest_corners)
+
+
+def test_validate_says_which_seams_dress_gathers(run_cli, tmp_path):
+    """`kitsuke pattern validate` warns of every length mismatch and says which ones a wrap gathers (the same rule
+    as the wrap's: over 3 % and 1 cm)."""
+    from kitsuke.dressing._gather import gathered_seams
+    from kitsuke.pattern import save_pattern
+
+    gathered, rounded = _band_on_panel(30.0, 20.0), _band_on_panel(20.4, 20.0)
+    assert gathered_seams(gathered, 0.03, 1.0) == [0] and gathered_seams(rounded, 0.03, 1.0) == []
+    for pattern, says in ((gathered, True), (rounded, False)):
+        path = tmp_path / f"{pattern.pieces[0].outline[1, 0]:g}.json"
+        save_pattern(pattern, path)
+        r = run_cli("pattern", "validate", path)
+        assert r.code == 0 and "apart" in r.err
+        assert ("its longer side is gathered" in r.err) == says

@@ -100,7 +100,8 @@ def register(parser: argparse.ArgumentParser) -> None:
         "Check a pattern file. Errors (unreadable file, self-intersecting or zero-area outline, clockwise "
         "outline, seams naming unknown pieces or edges, duplicate names, seams that cannot be sewn into one "
         "garment surface, which `kitsuke dress` would refuse) give one line on stderr and exit code 2; "
-        "warnings (seam edges differing by more than 1 %) are printed and the exit code is 0.",
+        "warnings (seam edges differing by more than 1 %; where they differ by more than 3 % and 1 cm, `dress` "
+        "gathers the longer side) are printed and the exit code is 0.",
         FORMATS + "\nexample:\n  kitsuke pattern validate my_pattern.json\n",
     )
     p.add_argument("pattern", metavar="PATTERN", help="pattern file")
@@ -237,6 +238,23 @@ def _print_warnings(issues) -> None:
         print(f"kitsuke: warning: {i.message}", file=sys.stderr)
 
 
+def _said_gathered(pattern, issues) -> list:
+    """The issues, each length mismatch that `kitsuke dress` gathers saying so."""
+    import dataclasses
+
+    from ..dressing._gather import gathered_seams
+    from ..dressing.wrap_settings import GatherSettings
+
+    g = GatherSettings()
+    gathered = set(gathered_seams(pattern, g.min_difference, g.min_cm))
+    return [
+        dataclasses.replace(i, message=i.message + "; dressed, its longer side is gathered")
+        if i.code == "length-mismatch" and i.seam in gathered
+        else i
+        for i in issues
+    ]
+
+
 def run_convert(args: argparse.Namespace) -> int:
     from ..pattern import load_pattern_with_issues, save_pattern
 
@@ -301,7 +319,7 @@ def run_validate(args: argparse.Namespace) -> int:
         check_sewable(pattern)  # what `dress` meshes and sews: the same refusals, here
     except InputError as e:
         raise InputError(e.message, args.pattern) from None
-    _print_warnings(issues)
+    _print_warnings(_said_gathered(pattern, issues))
     print(
         f"{args.pattern}: ok: {len(pattern.pieces)} pieces, {len(pattern.seams)} seams, "
         f"{len(issues)} warning{'s' * (len(issues) != 1)}"

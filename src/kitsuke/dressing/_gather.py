@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..pattern import PatternMesh
+from ..pattern import Pattern, PatternMesh
 from ._weld import Welded
 
 
@@ -27,6 +27,22 @@ class Gather:
     piece: str
     ratio: float
     faces: int
+
+
+def gathers(a_cm: float, b_cm: float, min_difference: float, min_cm: float) -> bool:
+    """Whether a seam whose sides are `a_cm` and `b_cm` long gathers its longer side: they differ by more than
+    `min_difference` of the longer and by more than `min_cm`."""
+    longer, excess = max(a_cm, b_cm), abs(a_cm - b_cm)
+    return longer > 0 and excess > min_difference * longer and excess > min_cm
+
+
+def gathered_seams(pattern: Pattern, min_difference: float, min_cm: float) -> list[int]:
+    """Indices of the pattern's seams that a wrap gathers (`gathers`, on the pattern's edge lengths)."""
+    return [
+        s
+        for s, seam in enumerate(pattern.seams)
+        if gathers(pattern.edge_length(seam.a), pattern.edge_length(seam.b), min_difference, min_cm)
+    ]
 
 
 def gathered_rest(
@@ -50,14 +66,13 @@ def gathered_rest(
             continue
         lengths = [float(np.linalg.norm(np.diff(uv[pairs[:, k]], axis=0), axis=1).sum()) for k in (0, 1)]
         longer = int(np.argmax(lengths))
-        excess = lengths[longer] - lengths[1 - longer]
-        if not lengths[longer] > 0 or excess <= min_difference * lengths[longer] or excess <= min_cm:
+        if not gathers(lengths[0], lengths[1], min_difference, min_cm):
             continue
         piece = int(pm.vertex_piece[pairs[0, longer]])
         sides.setdefault(piece, []).append((s, uv[pairs[:, longer]], lengths[1 - longer] / lengths[longer]))
     face_piece = np.searchsorted(welded.piece_faces[:, 1], np.arange(len(rest)), side="right")
     centroid_cm = rest.mean(axis=1) * 100.0
-    gathers: list[Gather] = []
+    made: list[Gather] = []
     for piece, seams in sides.items():
         faces = np.flatnonzero(face_piece == piece)
         near = [_nearest_along(centroid_cm[faces], line) for _, line, _ in seams]
@@ -74,8 +89,8 @@ def gathered_rest(
         along = np.einsum("fkc,fc->fk", rel, t)
         rest[faces] = c + rel - ((1.0 - scale)[:, None] * along)[..., None] * t[:, None, :]
         for k, (s, _, r) in enumerate(seams):
-            gathers.append(Gather(s, pm.piece_names[piece], r, int((which == k).sum())))
-    return rest, sorted(gathers, key=lambda g: g.seam)
+            made.append(Gather(s, pm.piece_names[piece], r, int((which == k).sum())))
+    return rest, sorted(made, key=lambda g: g.seam)
 
 
 def _nearest_along(points: np.ndarray, line: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
