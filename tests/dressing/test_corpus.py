@@ -12,7 +12,7 @@ import pytest
 
 from kitsuke.body import load_body
 from kitsuke.cloth import BodyCollider
-from kitsuke.dressing import on_body_failures, perturb_strokes, suggest_strokes, target_misses, wrap
+from kitsuke.dressing import DragSession, on_body_failures, perturb_strokes, suggest_strokes, target_misses, wrap
 from kitsuke.errors import ComputationError
 from kitsuke.metrics import QualityTargets
 from kitsuke.pattern import load_pattern
@@ -51,6 +51,9 @@ def _outcome(body, collider, surface, path) -> str:
     # Written: a garment on the body, finite, nowhere torn, every stroke's cloth near it.
     assert on_body_failures(garment, body, surface=surface) == [], name
     assert np.isfinite(garment.positions).all() and garment.report.strain_max < 1.0, name
+    if garment.gathers:  # a later drag rests the cloth gathered, as the wrap did
+        drag = DragSession(body, garment, collider=collider)
+        np.testing.assert_array_equal(drag.model.rest_lengths, garment.model.rest_lengths)
     return "within" if not target_misses(garment, QualityTargets.robust()) else "written"
 
 

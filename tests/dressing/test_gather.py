@@ -85,3 +85,22 @@ def test_validate_says_which_seams_dress_gathers(run_cli, tmp_path):
         r = run_cli("pattern", "validate", path)
         assert r.code == 0 and "apart" in r.err
         assert ("its longer side is gathered" in r.err) == says
+
+
+def test_a_garment_with_its_own_rest_shape_is_dragged_and_measured_at_it(body):
+    """A GarmentFile whose rest shape is not its uv (gathered): the drag's model rests at it (from the uv it
+    would pull the gathers open) and the strain map measures against it."""
+    from kitsuke.dressing import DragSession
+    from kitsuke.dressing.export import GarmentFile
+
+    uv = np.array([[0.0, 0.0], [0.1, 0.0], [0.1, 0.1], [0.0, 0.1]])
+    faces = np.array([[0, 1, 2], [0, 2, 3]])
+    corner_uv = uv[faces]
+    gathered = corner_uv * [0.7, 1.0]
+    positions = np.c_[gathered[[0, 0, 0, 1], [0, 1, 2, 2]], np.zeros(4)] + [-0.035, 1.2, 0.3]
+    file = GarmentFile(positions, faces, corner_uv, ["sheet"], np.array([[0, 2]]), rest_corners=gathered)
+    session = DragSession(body, file)
+    np.testing.assert_allclose(np.sort(session.model.rest_lengths), np.sort(
+        ClothModel.from_corners(faces, gathered, n_vertices=4).rest_lengths))  # fmt: skip
+    np.testing.assert_allclose(file.rest_edge_lengths[0, 0], 0.07)
+    assert session.report().strain_max < 1e-9  # lying at its gathered rest: no strain

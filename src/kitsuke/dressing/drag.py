@@ -377,7 +377,7 @@ class DragSession:
         self._file = dataclasses.replace(self._file, contact_offset_m=cloth.contact_offset_m)  # what it is dragged at
         try:
             self.model = ClothModel.from_corners(
-                f.faces, f.corner_uv, n_vertices=len(f.positions), params=cloth, face_layer=f.face_layer
+                f.faces, f.rest_shape, n_vertices=len(f.positions), params=cloth, face_layer=f.face_layer
             )
             self.state = ClothState.new(self.model, f.positions)
         except InputError as e:
@@ -468,6 +468,7 @@ class DragSession:
             corner_uv=ordered.corner_uv,
             piece_faces=ordered.piece_faces,
             face_layer=ordered.model.face_layer,
+            rest_corners=None if self._file.rest_corners is None else ordered.model.rest_corners,
         )
         # The session's own state holds no pins: each step is given the ones it holds.
         self.model, self.state = ordered.model, state.holding(np.zeros(ordered.model.n_vertices, dtype=bool))

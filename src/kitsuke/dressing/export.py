@@ -42,6 +42,9 @@ class GarmentFile:
     name : the garment's name (from the file's `# kitsuke dressed garment <name>` line; "garment" without one).
     face_layer : (F,) int8 cloth layer of each face (`kitsuke.cloth.ClothModel.face_layer`), or None.
     contact_offset_m : metres off the body it was dressed at (`ClothParams.contact_offset_m`), or None (not said).
+    rest_corners : (F, 3, 2) float64 metres, the cloth's rest shape where it is not the pattern's (a gathered
+        seam: `DressedGarment.gathers`), or None: corner_uv is the rest shape. Not written to the OBJ, whose vt
+        stay the pattern's (a garment read back is measured ungathered).
     The writers below take a GarmentFile as well as a DressedGarment (a dragged garment is written this way).
     """
 
@@ -53,11 +56,17 @@ class GarmentFile:
     name: str = "garment"
     face_layer: np.ndarray | None = None
     contact_offset_m: float | None = None
+    rest_corners: np.ndarray | None = None
+
+    @property
+    def rest_shape(self) -> np.ndarray:
+        """(F, 3, 2) float64 metres: the corners a cloth model of this garment rests at."""
+        return self.corner_uv if self.rest_corners is None else self.rest_corners
 
     @property
     def rest_edge_lengths(self) -> np.ndarray:
-        """(F, 3) float64 metres: rest length of each face's edges (0-1, 1-2, 2-0) from the pattern."""
-        uv = self.corner_uv
+        """(F, 3) float64 metres: rest length of each face's edges (0-1, 1-2, 2-0) of its rest shape."""
+        uv = self.rest_shape
         return np.linalg.norm(uv[:, [1, 2, 0]] - uv, axis=2)
 
 
@@ -237,5 +246,6 @@ def as_garment_file(garment: DressedGarment | GarmentFile) -> GarmentFile:
             garment.name,
             garment.model.face_layer,
             garment.model.params.contact_offset_m,
+            garment.model.rest_corners if garment.gathers else None,
         )
     raise InputError("garment must be a DressedGarment or a GarmentFile (read_garment_obj)")

@@ -206,7 +206,7 @@ def rewrap(
         collider = BodyCollider.from_mesh(mesh) if isinstance(body, TriMesh) else BodyCollider.from_body(body)
     model = ClothModel.from_corners(
         g.faces,
-        g.corner_uv,
+        g.rest_shape,
         n_vertices=len(g.positions),
         params=offset_as_dressed(garment, p.cloth),
         face_layer=g.face_layer,

@@ -96,7 +96,7 @@ def cloth_model(garment) -> ClothModel:  # noqa: ANN001 - DressedGarment or Garm
     offset = g.contact_offset_m if g.contact_offset_m else ClothParams().contact_offset_m
     return ClothModel.from_corners(
         g.faces,
-        g.corner_uv,
+        g.rest_shape,
         n_vertices=len(g.positions),
         face_layer=g.face_layer,
         params=ClothParams(contact_offset_m=offset),
