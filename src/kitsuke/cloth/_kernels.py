@@ -332,6 +332,36 @@ def limit_strain(order, n_order, rank, movable, adj_ptr, adj, adj_edge, rest_len
 
 
 @njit(cache=True)
+def _project_edge(pos, a, b, rest, movable, omega, band):
+    """Move the movable ends of edge a-b (in place on pos) along it to its rest length `rest` (or the nearer end of
+    its band), times `omega`; returns the error corrected, metres (0.0: left alone)."""
+    wa = 1.0 if movable[a] else 0.0
+    wb = 1.0 if movable[b] else 0.0
+    if wa + wb == 0.0:
+        return 0.0
+    dx, dy, dz = pos[b, 0] - pos[a, 0], pos[b, 1] - pos[a, 1], pos[b, 2] - pos[a, 2]
+    d = math.sqrt(dx * dx + dy * dy + dz * dz)
+    if d * d < TINY2:
+        return 0.0
+    err = d - rest
+    slack = band * rest
+    if err > slack:
+        err -= slack
+    elif err < -slack:
+        err += slack
+    else:
+        return 0.0
+    f = omega * err / (d * (wa + wb))
+    pos[a, 0] += wa * f * dx
+    pos[a, 1] += wa * f * dy
+    pos[a, 2] += wa * f * dz
+    pos[b, 0] -= wb * f * dx
+    pos[b, 1] -= wb * f * dy
+    pos[b, 2] -= wb * f * dz
+    return err
+
+
+@njit(cache=True)
 def project_lengths(pos, edges, rest_lengths, movable, order, omega, band):
     """One Gauss-Seidel sweep (in place on pos (V, 3)): each edge in `order` moves its movable ends, half each
     (all of it for one movable end), along the edge until it has its rest length, times `omega` (1: exactly;
@@ -344,31 +374,8 @@ def project_lengths(pos, edges, rest_lengths, movable, order, omega, band):
     worst = 0.0
     for o in range(len(order)):
         e = order[o]
-        a, b = edges[e, 0], edges[e, 1]
-        wa = 1.0 if movable[a] else 0.0
-        wb = 1.0 if movable[b] else 0.0
-        if wa + wb == 0.0:
-            continue
-        dx, dy, dz = pos[b, 0] - pos[a, 0], pos[b, 1] - pos[a, 1], pos[b, 2] - pos[a, 2]
-        d = math.sqrt(dx * dx + dy * dy + dz * dz)
-        if d * d < TINY2:
-            continue
-        err = d - rest_lengths[e]
-        slack = band * rest_lengths[e]
-        if err > slack:
-            err -= slack
-        elif err < -slack:
-            err += slack
-        else:
-            continue
+        err = _project_edge(pos, edges[e, 0], edges[e, 1], rest_lengths[e], movable, omega, band)
         worst = max(worst, abs(err))
-        f = omega * err / (d * (wa + wb))
-        pos[a, 0] += wa * f * dx
-        pos[a, 1] += wa * f * dy
-        pos[a, 2] += wa * f * dz
-        pos[b, 0] -= wb * f * dx
-        pos[b, 1] -= wb * f * dy
-        pos[b, 2] -= wb * f * dz
     return worst
 
 
@@ -391,34 +398,14 @@ def project_band(pos, edges, rest_lengths, movable, order, band, moved, seen, cl
             continue
         t += 1
         seen[e] = t
-        wa = 1.0 if movable[a] else 0.0
-        wb = 1.0 if movable[b] else 0.0
-        if wa + wb == 0.0:
-            continue
-        dx, dy, dz = pos[b, 0] - pos[a, 0], pos[b, 1] - pos[a, 1], pos[b, 2] - pos[a, 2]
-        d = math.sqrt(dx * dx + dy * dy + dz * dz)
-        if d * d < TINY2:
-            continue
-        err = d - rest_lengths[e]
-        slack = band * rest_lengths[e]
-        if err > slack:
-            err -= slack
-        elif err < -slack:
-            err += slack
-        else:
+        err = _project_edge(pos, a, b, rest_lengths[e], movable, 1.0, band)
+        if err == 0.0:
             continue
         worst = max(worst, abs(err))
-        f = err / (d * (wa + wb))
         t += 1
-        if wa > 0.0:
-            pos[a, 0] += f * dx
-            pos[a, 1] += f * dy
-            pos[a, 2] += f * dz
+        if movable[a]:
             moved[a] = t
-        if wb > 0.0:
-            pos[b, 0] -= f * dx
-            pos[b, 1] -= f * dy
-            pos[b, 2] -= f * dz
+        if movable[b]:
             moved[b] = t
     clock[0] = t
     return worst
