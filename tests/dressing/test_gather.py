@@ -104,3 +104,13 @@ def test_a_garment_with_its_own_rest_shape_is_dragged_and_measured_at_it(body):
         ClothModel.from_corners(faces, gathered, n_vertices=4).rest_lengths))  # fmt: skip
     np.testing.assert_allclose(file.rest_edge_lengths[0, 0], 0.07)
     assert session.report().strain_max < 1e-9  # lying at its gathered rest: no strain
+
+
+def test_gather_settings_refuse_negative_or_non_finite_values():
+    from kitsuke.dressing.wrap import WrapParams
+    from kitsuke.errors import InputError
+
+    for name in ("gather.min_difference", "gather.min_cm", "gather.depth_cm"):
+        for bad in (-1.0, float("nan"), float("inf")):
+            with pytest.raises(InputError, match=name.split(".")[1]):
+                WrapParams().changed({name: bad})
