@@ -60,19 +60,32 @@ def _stroked_pieces(garment) -> set[int]:
     return out
 
 
-def wrong_side(garment, mesh: TriMesh) -> list[str]:
+def body_axis(mesh: TriMesh) -> np.ndarray:
+    """(2,) metres: the body's vertical axis as an (x, z) point, the middle of its bounding box."""
+    lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+    return 0.5 * (lo + hi)[[0, 2]]
+
+
+def mean_turn(placed: np.ndarray, worn: np.ndarray) -> float:
+    """Radians: the mean turn about the vertical axis taking directions `placed` (n, 2) (x, z from the body's axis)
+    to `worn` (n, 2), averaged on the circle (each weighs the same; 0.0 for none)."""
+    placed, worn = np.reshape(placed, (-1, 2)), np.reshape(worn, (-1, 2))
+    t = np.arctan2(worn[:, 0], worn[:, 1]) - np.arctan2(placed[:, 0], placed[:, 1])
+    return float(np.angle(np.exp(1j * t).sum())) if len(t) else 0.0
+
+
+def wrong_side_pieces(garment, mesh: TriMesh) -> list[tuple[int, str]]:
     """Pieces without a stroke that ended on the other side of the body from where their placement puts them (a
-    skirt's front found hanging off the back left of the hip), one line each. The strokes may turn the whole
-    garment (a skirt worn back to front on purpose): each piece is judged against its placement turned as the
-    stroked pieces turned theirs (on average round the body's vertical axis). Pieces with a stroke are judged by
-    their strokes (`STROKE_LOST_M`), pieces without a placement not at all."""
+    skirt's front found hanging off the back left of the hip): (piece index, one line saying so) each. The strokes
+    may turn the whole garment (a skirt worn back to front on purpose): each piece is judged against its placement
+    turned as the stroked pieces turned theirs (on average round the body's vertical axis). Pieces with a stroke
+    are judged by their strokes (`STROKE_LOST_M`), pieces without a placement not at all."""
     pm = getattr(garment, "pattern_mesh", None)
     vertex_of = getattr(garment, "pattern_vertex", None)
     if pm is None or vertex_of is None or len(vertex_of) != pm.n_vertices:
         return []
-    lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
-    axis = 0.5 * (lo + hi)[[0, 2]]
-    turn = {}  # piece -> (placed direction, worn direction, the turn between them in radians)
+    axis = body_axis(mesh)
+    sides = {}  # piece -> (placed direction, worn direction)
     for k in range(len(pm.piece_names)):
         if not pm.placed[k]:
             continue
@@ -80,12 +93,13 @@ def wrong_side(garment, mesh: TriMesh) -> list[str]:
         placed = pm.positions_m[a:b].mean(axis=0)[[0, 2]] - axis
         worn = garment.positions[vertex_of[a:b]].mean(axis=0)[[0, 2]] - axis
         if min(np.linalg.norm(placed), np.linalg.norm(worn)) >= SIDE_M:
-            turn[k] = (placed, worn, np.arctan2(worn[0], worn[1]) - np.arctan2(placed[0], placed[1]))
-    stroked = _stroked_pieces(garment) & set(turn)
-    garment_turn = np.angle(sum(np.exp(1j * turn[k][2]) for k in stroked)) if stroked else 0.0
+            sides[k] = (placed, worn)
+    stroked = sorted(_stroked_pieces(garment) & set(sides))
+    garment_turn = mean_turn(np.array([sides[k][0] for k in stroked]), np.array([sides[k][1] for k in stroked]))
     out = []
-    for k, (placed, worn, t) in turn.items():
-        off = abs(np.angle(np.exp(1j * (t - garment_turn))))
+    for k, (placed, worn) in sides.items():
+        off = abs(mean_turn(placed[None], worn[None]) - garment_turn)
+        off = min(off, 2 * np.pi - off)
         if k not in stroked and off > np.radians(WRONG_SIDE_DEG):
             where = f"its placement puts it at the {_side(placed)}"
             if abs(garment_turn) > np.radians(SAME_TURN_DEG):
@@ -94,8 +108,13 @@ def wrong_side(garment, mesh: TriMesh) -> list[str]:
                 turned = _side(np.array([np.sin(a), np.cos(a)]))
                 by = f"{np.degrees(garment_turn):+.0f}°"
                 where = f"its placement, turned {by} as the stroked pieces were, puts it at the {turned}"
-            out.append(f"piece {pm.piece_names[k]} ended at the body's {_side(worn)}; {where}")
+            out.append((k, f"piece {pm.piece_names[k]} ended at the body's {_side(worn)}; {where}"))
     return out
+
+
+def wrong_side(garment, mesh: TriMesh) -> list[str]:
+    """`wrong_side_pieces`' lines."""
+    return [line for _, line in wrong_side_pieces(garment, mesh)]
 
 
 def _piece_of_vertex(garment) -> np.ndarray:

@@ -12,7 +12,9 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
    taken the way round the placement or the pattern's up says.
 2. **Growth** (`_grow`): the rest of the garment grows ring by ring from the placed triangles, each new triangle
    unfolded from its placed neighbour (from the cloth, not the body), with relaxation and collision between rings.
-   The stroke triangles stay pinned while the garment grows.
+   The stroke triangles stay pinned while the garment grows. Pieces named in `grow.laid` are not grown but laid
+   where the pattern's placement puts them (`_laid`); a wrap whose result has a piece without strokes on the wrong
+   side of the body (`outcome.wrong_side_pieces`) lays those pieces and dresses once more (`grow.relay`).
 3. **Seams**: the garment mesh shares the vertices of every seam from the start (`_weld`; corners where two seams
    of one piece meet are repaired first, `repair_corners`), so where two grown regions meet at a seam the
    triangles between them are stretched. A closing relaxation without gravity (`_solve.GlobalRelax`: a global
@@ -74,6 +76,7 @@ from ..metrics import QualityReport, QualityTargets, quality_report, strain
 from ..pattern import Pattern, PatternMesh, face_layers, mesh_pattern
 from ._bridge import bridged, spans_legs
 from ._gather import Gather, gathered_rest
+from ._laid import lay_at_placement
 from ._mend import MendStats, mend_tears
 from ._place import StrokeTrack, place_strokes
 from ._polish_step import polish_step
@@ -96,7 +99,7 @@ from ._stages import (
     untangle_stage,
 )
 from ._weld import repair_corners, weld
-from .outcome import on_body_failures, target_misses
+from .outcome import body_axis, on_body_failures, target_misses, wrong_side_pieces
 from .strokes import Strokes, resolve_strokes
 from .wrap_settings import WrapParams
 
@@ -122,6 +125,8 @@ class DressedGarment:
     loose_strokes : ids of the strokes not held to their body strokes after the settle (`TetherSettings.slack_m`).
     gathers : the seams whose longer side was gathered onto the shorter (`WrapParams.gather`): the model's rest
         shape is gathered there, and strain is measured against it.
+    laid : pieces laid at their placement instead of grown (`GrowSettings.laid`; by the wrap itself where growth
+        took them to the wrong side of the body, the first try's time in timings["first try"]).
     rings : growth rings. mend : what `_mend.mend_tears` did after the close (rounds, torn edges before and
         after). polished : the polish's result was kept (`PolishSettings.rounds`). timings : seconds per step
         ("mesh", "resolve", "place", "grow", "close", "settle", "finish", "untangle", "polish", "wrap" = all of
@@ -145,6 +150,7 @@ class DressedGarment:
     tracks: list[StrokeTrack] = field(default_factory=list, repr=False)
     loose_strokes: list[int] = field(default_factory=list)
     gathers: list[Gather] = field(default_factory=list)
+    laid: list[str] = field(default_factory=list)
     rings: int = 0
     mend: MendStats = field(default_factory=MendStats)
     polished: bool = False
@@ -175,6 +181,7 @@ class DressedGarment:
             "polished": self.polished,
             "loose_strokes": list(self.loose_strokes),
             "gathered_seams": [dataclasses.asdict(g) | {"ratio": round(g.ratio, 4)} for g in self.gathers],
+            "laid_pieces": list(self.laid),
             "timings_s": {k: round(v, 4) for k, v in self.timings.items()},
             "strokes": [
                 {
@@ -314,6 +321,13 @@ def wrap(
         hang = hang or p.grow.skirt_hang
     placements = None if pattern is None else {pc.name: pc.placement for pc in pattern.pieces if pc.placement}
     placement = place_strokes(pm, welded, strokes, surface, collider, lift_m=p.grow.lift_m, placements=placements)
+    seed_pins = placement.placed.copy()  # the stroke triangles' vertices, held while the garment grows
+    unknown = sorted(set(p.grow.laid) - set(pm.piece_names))
+    if unknown:
+        raise InputError(f"grow.laid names no piece {', '.join(map(repr, unknown))} of pattern {pm.name!r}")
+    laid = [k for k, name in enumerate(pm.piece_names) if name in p.grow.laid and pm.placed[k]]
+    if laid:
+        placement = lay_at_placement(pm, welded, placement, laid, body_axis(mesh))
     grow_params = dataclasses.replace(p.cloth, gravity_step_m=0.0)
     layer = face_layers(pm.layers, pm.piece_names, welded.piece_faces, welded.rest_corners * 100.0)
     # Seams of unequal sides gather the longer one: the model's rest shape (its uv stays the pattern's).
@@ -323,7 +337,6 @@ def wrap(
         welded.faces, rest, n_vertices=welded.n_vertices, params=grow_params, face_layer=layer
     )
     state = ClothState.new(model, placement.positions, face_active=placement.seed_faces)
-    seed_pins = placement.placed.copy()  # the stroke triangles' vertices, held while the garment grows
     free = np.zeros(model.n_vertices, dtype=bool)
     timings["place"] = time.perf_counter() - t2
     log = StageLog("wrap", say, timings)
@@ -456,6 +469,7 @@ def wrap(
         tracks=tracks,
         loose_strokes=[tr.id for tr, far in zip(placement.tracks, loose, strict=True) if far],
         gathers=gathers,
+        laid=[pm.piece_names[k] for k in laid],
         rings=grown["rings"],
         polished=done.polished,
         mend=mended,
@@ -475,7 +489,27 @@ def wrap(
         bad = on_body_failures(result, body, surface=surface)
         if bad:
             more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
-            raise ComputationError("wrap", f"not a garment on the body: {bad[0]}{more}", result=result)
+            failure = ComputationError("wrap", f"not a garment on the body: {bad[0]}{more}", result=result)
+            wrong = [pm.piece_names[k] for k, _ in wrong_side_pieces(result, mesh) if k not in laid]
+            if not (p.grow.relay and wrong):
+                raise failure
+            say(f"laying {', '.join(wrong)} at the placement")
+            again = p.changed({"grow.laid": tuple(p.grow.laid) + tuple(wrong)})
+            try:
+                redone = wrap(
+                    body,
+                    garment,
+                    strokes,
+                    pattern=pattern,
+                    params=again,
+                    collider=collider,
+                    report=report,
+                    progress=progress,
+                )
+            except ComputationError:
+                raise failure from None
+            redone.timings["first try"] = timings["wrap"]
+            return redone
     return result
 
 

@@ -30,6 +30,8 @@ def _of_kind(name: str, default: object, value: object) -> object:
     are: their own checks judge them."""
     if value is None or default is None or dataclasses.is_dataclass(default):
         return value
+    if isinstance(default, tuple) and isinstance(value, str):  # names as text: "skirt_front, wb_front"
+        value = tuple(v.strip() for v in value.split(",") if v.strip())
     if isinstance(default, bool):
         ok = isinstance(value, bool)
         kind = "True or False"
@@ -86,6 +88,10 @@ class GrowSettings:
         grown over the hips drapes round both legs. None: when the garment has an opening below the crotch that
         goes round both legs (`_bridge.spans_legs`: a skirt's hem, not a trouser leg's); True / False: always /
         never.
+    laid : names of pieces without strokes laid where the pattern's placement puts them (turned and moved as the
+        stroked pieces were) instead of grown (`_laid`); pieces without a placement are grown.
+    relay : when growth takes a piece without strokes to the wrong side of the body (`outcome.wrong_side_pieces`),
+        dress once more with it laid (added to `laid`), while that finds new pieces.
     """
 
     lift_m: float = 0.004
@@ -95,6 +101,8 @@ class GrowSettings:
     skirt_hang: float = 2.0
     hang_clearance_m: float = 0.03
     bridge_legs: bool | None = None
+    laid: tuple[str, ...] = ()
+    relay: bool = True
 
     def __post_init__(self) -> None:
         _at_least(self, 1, "rings_per_relax")
@@ -104,6 +112,8 @@ class GrowSettings:
         require_non_negative(self, "GrowSettings", "hang", "skirt_hang")
         if self.bridge_legs not in (None, True, False):
             raise InputError(f"GrowSettings.bridge_legs must be None, True or False, got {self.bridge_legs!r}")
+        if not all(isinstance(name, str) for name in self.laid):
+            raise InputError("GrowSettings.laid must be piece names")
 
 
 @dataclass(frozen=True)

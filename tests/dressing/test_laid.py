@@ -1,0 +1,116 @@
+"""Pieces laid at their placement instead of grown (`_laid.lay_at_placement`, `GrowSettings.laid` and `.relay`):
+a skirt's front with no stroke, grown from the back's side seams, ends behind the body; laid where its placement
+puts it, turned and moved as the stroked back was, it is sewn on at the front."""
+
+from __future__ import annotations
+
+import zlib
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from kitsuke.body import load_body
+from kitsuke.cloth import BodyCollider
+from kitsuke.dressing import WrapParams, on_body_failures, perturb_strokes, suggest_strokes, wrap
+from kitsuke.dressing._laid import lay_at_placement
+from kitsuke.dressing._place import Placement
+from kitsuke.dressing.outcome import mean_turn, wrong_side_pieces
+from kitsuke.errors import InputError
+from kitsuke.pattern import load_pattern
+
+from ..conftest import DATA
+
+SKIRT = DATA / "pattern" / "corpus" / "gc_s101_0003_specification.json"
+
+
+def _turned(p: np.ndarray, degrees: float, axis: np.ndarray) -> np.ndarray:
+    """Points (n, 3) turned about the vertical line through `axis` (x, z): +90° takes +Z (front) to +X (left)."""
+    a = np.radians(degrees)
+    x, z = p[:, 0] - axis[0], p[:, 2] - axis[1]
+    return np.c_[axis[0] + np.cos(a) * x + np.sin(a) * z, p[:, 1], axis[1] - np.sin(a) * x + np.cos(a) * z]
+
+
+def test_mean_turn_measures_the_turn_round_the_axis():
+    front, left = np.array([[0.0, 1.0]]), np.array([[1.0, 0.0]])
+    assert mean_turn(front, left) == pytest.approx(np.pi / 2)
+    assert mean_turn(left, front) == pytest.approx(-np.pi / 2)
+    # averaged on the circle: 170° and -170° average to 180°, not 0°
+    two = np.array([[0.0, 1.0], [0.0, 1.0]])
+    worn = np.array([[np.sin(np.radians(170)), np.cos(np.radians(170))], [np.sin(np.radians(-170)), -0.985]])
+    assert abs(mean_turn(two, worn)) == pytest.approx(np.pi, abs=0.01)
+    assert mean_turn(np.zeros((0, 2)), np.zeros((0, 2))) == 0.0
+
+
+def test_a_laid_piece_is_turned_and_moved_as_the_stroked_pieces_were():
+    axis = np.array([0.02, -0.01])
+    rng = np.random.default_rng(3)
+    back = rng.normal([0.0, 1.0, -0.2], 0.05, (6, 3))  # piece 0, placed behind; its stroke put it turned 30°, 4 cm down
+    front = rng.normal([0.0, 1.0, 0.25], 0.05, (5, 3))  # piece 1, placed in front, no stroke
+    pm = SimpleNamespace(
+        positions_m=np.r_[back, front], placed=np.array([True, True]), piece_vertices=np.array([[0, 6], [6, 11]])
+    )
+    welded = SimpleNamespace(vertex_of=np.arange(11)[::-1].copy(), piece_faces=np.array([[0, 4], [4, 7]]))
+    positions = np.zeros((11, 3))
+    placed = np.zeros(11, dtype=bool)
+    worn_back = _turned(back, 30.0, axis) - [0.0, 0.04, 0.0]
+    positions[welded.vertex_of[:6]] = worn_back
+    placed[welded.vertex_of[:6]] = True
+    seed = np.zeros(7, dtype=bool)
+    seed[:4] = True
+    laid = lay_at_placement(pm, welded, Placement(positions, placed, seed, []), [1], axis)
+    np.testing.assert_allclose(laid.positions[welded.vertex_of[6:]], _turned(front, 30.0, axis) - [0.0, 0.04, 0.0])
+    np.testing.assert_array_equal(laid.positions[welded.vertex_of[:6]], worn_back)  # the stroked piece stays
+    assert laid.placed.all() and laid.seed_faces.all()
+    assert not placed[welded.vertex_of[6:]].any()  # the placement it was given is left as it was
+
+
+def test_laid_takes_piece_names():
+    assert WrapParams().changed({"grow.laid": "skirt_front, wb_front"}).grow.laid == ("skirt_front", "wb_front")
+    with pytest.raises(InputError, match="laid"):
+        WrapParams().changed({"grow.laid": (1, 2)})
+
+
+@pytest.fixture(scope="module")
+def skirt_on_back_stroke():
+    """GarmentCode's skirt with a waistband (tests corpus) on mean_all, from its suggested strokes as a hand drew
+    them: the front's stroke is the one left out, so only the back is stroked."""
+    body = load_body(DATA / "bodies" / "mean_all.obj")
+    collider = BodyCollider.from_body(body)
+    surface = collider.surface_for(body.mesh)
+    pattern = load_pattern(SKIRT)
+    name = SKIRT.stem.replace("_specification", "")
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    strokes = perturb_strokes(suggest_strokes(body, pattern, surface=surface), surface, rng)
+    assert [p.pattern.piece for p in strokes.pairs] == ["skirt_back"]
+    return body, collider, surface, pattern, strokes
+
+
+@pytest.mark.slow
+def test_the_unstroked_pieces_laid_at_their_placement_are_worn_where_it_puts_them(skirt_on_back_stroke):
+    body, collider, surface, pattern, strokes = skirt_on_back_stroke
+    unstroked = ["wb_back", "wb_front", "skirt_front"]  # in the pattern's order, as `laid` lists them
+    params = WrapParams().changed({"grow.laid": tuple(unstroked), "grow.relay": False})
+    g = wrap(body, pattern, strokes, collider=collider, params=params)
+    assert g.laid == unstroked and g.summary()["laid_pieces"] == unstroked
+    assert wrong_side_pieces(g, body.mesh) == [] and on_body_failures(g, body, surface=surface) == []
+    k = g.piece_names.index("skirt_front")
+    a, b = g.piece_faces[k]
+    assert g.positions[np.unique(g.faces[a:b])][:, 2].mean() > 0.05  # in front of the body (it faces +Z)
+
+
+def test_a_laid_piece_the_pattern_does_not_have_is_refused(skirt_on_back_stroke):
+    body, collider, _, pattern, strokes = skirt_on_back_stroke
+    with pytest.raises(InputError, match="grow.laid names no piece 'skirt_frnt'"):
+        wrap(body, pattern, strokes, collider=collider, params=WrapParams().changed({"grow.laid": "skirt_frnt"}))
+
+
+@pytest.mark.slow
+def test_the_wrap_lays_what_growth_took_to_the_wrong_side(skirt_on_back_stroke):
+    """By itself (`grow.relay`, the default) the wrap ends with every unstroked piece on its placement's side, and
+    only pieces without a stroke are laid."""
+    body, collider, surface, pattern, strokes = skirt_on_back_stroke
+    g = wrap(body, pattern, strokes, collider=collider)
+    assert wrong_side_pieces(g, body.mesh) == [] and on_body_failures(g, body, surface=surface) == []
+    assert "skirt_back" not in g.laid
+    assert ("first try" in g.timings) == bool(g.laid)
