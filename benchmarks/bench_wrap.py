@@ -1,14 +1,21 @@
 """Benchmark: wrap + settle of GarmentCode's shirt (1.5 cm edges) on mean_all with the packaged strokes.
 
-    python benchmarks/bench_wrap.py [--repeat 5] [--settle global] [--polish-rounds 0]
+    python benchmarks/bench_wrap.py [--repeat 5] [--settle global] [--polish-rounds 0] [--cli 6]
 
 Prints the per-step timings of each run after a warm-up run (numba compilation, AABB trees) and the quality.
+With --cli N, N runs of the warm `kitsuke dress` of the same files (a new process each, wall time) alternate with
+N of the library's same call (`wrap(body, pattern, strokes)` from loaded objects: meshing, stroke resolution,
+collider and report included) in this process, and the medians and their ratio are printed (target <= 1.5x).
 """
 
 from __future__ import annotations
 
 import argparse
+import subprocess
+import sys
+import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +27,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--settle", choices=["jacobi", "global"], default="jacobi", help="SettleSettings.method")
+    ap.add_argument("--cli", type=int, default=0, metavar="N", help="time N warm `kitsuke dress` runs, and the library")
     ap.add_argument(
         "--polish-rounds", type=int, default=None, help="PolishSettings.rounds (default: the wrap's; 0: no polish)"
     )
@@ -66,6 +74,39 @@ def main() -> None:
         f"quality: penetration {r.penetration_count} (deepest {r.penetration_deepest_mm:.1f} mm), strain mean "
         f"{100 * r.strain_mean:.1f} % max {100 * r.strain_max:.2f} %, seam gap {r.seam_gap_mm} mm, inverted "
         f"{r.inverted_count}, stroke residual max {1e3 * g.max_stroke_residual_m:.0f} mm"
+    )
+    if args.cli:
+        cli_against_library(args.cli, lambda: wrap(body, pattern, strokes))
+
+
+def cli_against_library(n: int, library: Callable[[], object]) -> None:
+    """Median wall time of `kitsuke dress` (the shirt, GLB only) and of `library`, alternated n times."""
+    with tempfile.TemporaryDirectory() as tmp:
+        command = [
+            str(Path(sys.executable).with_name("kitsuke")),
+            "dress",
+            "--body",
+            str(ROOT / "tests/data/bodies/mean_all.obj"),
+            "--pattern",
+            str(ROOT / "tests/data/pattern/shirt_mean_specification.json"),
+            "--strokes",
+            str(ROOT / "src/kitsuke/assets/strokes/shirt_mean_all.json"),
+            "-o",
+            str(Path(tmp) / "shirt.glb"),
+        ]
+        subprocess.run(command, check=True, capture_output=True)  # numba's cache and the .pyc files filled
+        cli, lib = [], []
+        for _ in range(n):
+            t = time.perf_counter()
+            subprocess.run(command, check=True, capture_output=True)
+            cli.append(time.perf_counter() - t)
+            t = time.perf_counter()
+            library()
+            lib.append(time.perf_counter() - t)
+    c, w = float(np.median(cli)), float(np.median(lib))
+    print(
+        f"warm `kitsuke dress`: median {c:.2f} s ({min(cli):.2f}-{max(cli):.2f}); the library's same call: median "
+        f"{w:.2f} s ({min(lib):.2f}-{max(lib):.2f}); ratio {c / w:.2f}x (target <= 1.5x)"
     )
 
 

@@ -83,7 +83,7 @@ def test_bad_input_exit_2_one_line(run_cli, tmp_path, args, names):
     assert not list(tmp_path.glob(".*.tmp"))  # no half-written temporary left behind
 
 
-def test_subprocess_run(tmp_path):
+def test_subprocess_run(tmp_path, run_cli):
     out = tmp_path / "hoody.png"
     r = subprocess.run(
         [sys.executable, "-m", "kitsuke", "pattern", "convert", str(HOODY), str(out), "--max-px", "300"],
@@ -100,6 +100,13 @@ def test_subprocess_run(tmp_path):
         timeout=120,
     )
     assert r.returncode == 2 and r.stderr.strip().endswith("pattern file not found") and "missing.json" in r.stderr
+    # The program ends without the interpreter's teardown (`kitsuke.cli.run`): what it printed to a pipe arrives
+    # whole, as the same call prints it in-process.
+    r = subprocess.run(
+        [sys.executable, "-m", "kitsuke", "pattern", "info", str(HOODY)], capture_output=True, text=True, timeout=120
+    )
+    inproc = run_cli("pattern", "info", HOODY)
+    assert r.returncode == inproc.code == 0 and r.stdout == inproc.out and len(r.stdout) > 200
 
 
 def test_kimono_fit_height_gives_the_default_kimono(run_cli, tmp_path):

@@ -9,10 +9,12 @@ worked; an internal error -> exit code 1 (set KITSUKE_DEBUG=1 for the traceback)
 from __future__ import annotations
 
 import argparse
+import atexit
 import importlib
 import os
 import signal
 import sys
+import threading
 import traceback
 
 from ..errors import ComputationError, InputError
@@ -169,5 +171,25 @@ def main(argv: list[str] | None = None) -> int:
             signal.signal(signal.SIGTERM, previous)
 
 
+def run() -> None:
+    """The `kitsuke` program (`python -m kitsuke`): `main`, then the process ends at once.
+
+    Why: tearing down the interpreter's modules (numba, scipy, ...) took 0.14 s of a 2.2 s warm `kitsuke dress`
+    (measured, 2 cores). Every output is written and closed by then (atomic writes, context managers), and the
+    exit handlers run first (Ray's shutdown, temporary folders); with another non-daemon thread still running the
+    process ends the ordinary way, which waits for it.
+    """
+    code = main()
+    if any(t.is_alive() and not t.daemon for t in threading.enumerate() if t is not threading.main_thread()):
+        sys.exit(code)
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a closed pipe or stream: nothing more can reach it
+            pass
+    os._exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    run()

@@ -18,7 +18,7 @@ import io
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from xml.sax.saxutils import escape
+from html import escape
 
 import numpy as np
 
@@ -379,9 +379,9 @@ def sheet_to_svg(sheet: Sheet) -> str:
             if it.halo:  # a white outline underneath (a separate element: not every renderer knows paint-order)
                 out.append(
                     f'<text {attrs} fill="#ffffff" stroke="#ffffff" stroke-width="{0.22 * it.size:.3f}" '
-                    f'stroke-opacity="0.85">{escape(it.text)}</text>'
+                    f'stroke-opacity="0.85">{escape(it.text, quote=False)}</text>'
                 )
-            out.append(f'<text {attrs} fill="{it.colour}">{escape(it.text)}</text>')
+            out.append(f'<text {attrs} fill="{it.colour}">{escape(it.text, quote=False)}</text>')
     out.append("</g></svg>")
     if defs:
         out.insert(3, "<defs>" + "".join(defs) + "</defs>")
