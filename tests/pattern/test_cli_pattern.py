@@ -107,6 +107,15 @@ def test_subprocess_run(tmp_path, run_cli):
     )
     inproc = run_cli("pattern", "info", HOODY)
     assert r.returncode == inproc.code == 0 and r.stdout == inproc.out and len(r.stdout) > 200
+    # Its reader gone (`kitsuke pattern info P | head`): no message, the status of a process SIGPIPE ended.
+    p = subprocess.Popen(
+        [sys.executable, "-m", "kitsuke", "pattern", "info", str(HOODY)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    p.stdout.close()
+    assert p.wait(timeout=120) == 141 and p.stderr.read() == ""
 
 
 def test_kimono_fit_height_gives_the_default_kimono(run_cli, tmp_path):

@@ -158,6 +158,11 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("kitsuke: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # Whoever read the output stopped reading (`kitsuke pattern info P | head`): end quietly, as Unix tools
+        # do, with the status of a process that SIGPIPE ended; stdout goes nowhere, so no later flush fails.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
     except Exception as e:  # noqa: BLE001 - the last line of defence: an internal error, not the user's fault
         if os.environ.get("KITSUKE_DEBUG"):
             traceback.print_exc()
