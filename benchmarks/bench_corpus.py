@@ -260,13 +260,12 @@ def main() -> None:
     if args.batch and (args.drag or args.set):
         sys.exit("--drag and --set are for the plain run, not --batch")
 
-    import ast
-
     from kitsuke.body import load_body
     from kitsuke.cloth import BodyCollider
     from kitsuke.dressing import WrapParams
+    from kitsuke.dressing.options import parse_setting
 
-    changes = {k: ast.literal_eval(v) for k, v in (a.split("=", 1) for a in args.set)}
+    changes = dict(parse_setting(text) for text in args.set)
     params = WrapParams().changed(changes)
 
     body = load_body(BODY)

@@ -1,6 +1,7 @@
 """Pieces laid at their placement instead of grown (`_laid.lay_at_placement`, `GrowSettings.laid` and `.relay`):
 a skirt's front with no stroke, grown from the back's side seams, ends behind the body; laid where its placement
-puts it, turned and moved as the stroked back was, it is sewn on at the front."""
+puts it, turned and moved as the stroked back was, it is sewn on at the front. A shirt that growth tears round the
+arm is worn when every piece is laid."""
 
 from __future__ import annotations
 
@@ -12,16 +13,25 @@ import pytest
 
 from kitsuke.body import load_body
 from kitsuke.cloth import BodyCollider
-from kitsuke.dressing import WrapParams, on_body_failures, perturb_strokes, suggest_strokes, wrap
+from kitsuke.dressing import (
+    WrapParams,
+    on_body_failures,
+    perturb_strokes,
+    suggest_strokes,
+    target_misses,
+    wrap,
+)
 from kitsuke.dressing._laid import lay_at_placement
 from kitsuke.dressing._place import Placement
 from kitsuke.dressing.outcome import mean_turn, wrong_side_pieces
-from kitsuke.errors import InputError
+from kitsuke.errors import ComputationError, InputError
+from kitsuke.metrics import QualityTargets
 from kitsuke.pattern import load_pattern
 
 from ..conftest import DATA
 
 SKIRT = DATA / "pattern" / "corpus" / "gc_s101_0003_specification.json"
+TORN_SHIRT = DATA / "pattern" / "corpus" / "gc_s2718_0026_specification.json"
 
 
 def _turned(p: np.ndarray, degrees: float, axis: np.ndarray) -> np.ndarray:
@@ -114,3 +124,27 @@ def test_the_wrap_lays_what_growth_took_to_the_wrong_side(skirt_on_back_stroke):
     assert wrong_side_pieces(g, body.mesh) == [] and on_body_failures(g, body, surface=surface) == []
     assert "skirt_back" not in g.laid
     assert ("first try" in g.timings) == bool(g.laid)
+
+
+def test_laid_takes_every_piece():
+    assert WrapParams().changed({"grow.laid": "*"}).grow.laid == ("*",)
+
+
+@pytest.mark.slow
+def test_a_shirt_growth_tears_is_dressed_with_every_piece_laid():
+    """GarmentCode's shirt (tests corpus, seed 2718): grown from its strokes as a hand drew them, the front's side
+    goes over the upper arm and the side seam closes with the arm inside the torso, and the wrap fails; dressed
+    once more with every piece laid at its placement and sewn by the close, it is worn within the targets."""
+    body = load_body(DATA / "bodies" / "mean_all.obj")
+    collider = BodyCollider.from_body(body)
+    surface = collider.surface_for(body.mesh)
+    pattern = load_pattern(TORN_SHIRT)
+    name = TORN_SHIRT.stem.replace("_specification", "")
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    strokes = perturb_strokes(suggest_strokes(body, pattern, surface=surface), surface, rng)
+    with pytest.raises(ComputationError, match="wrap: not a garment on the body"):
+        wrap(body, pattern, strokes, collider=collider, params=WrapParams().changed({"grow.relay": False}))
+    g = wrap(body, pattern, strokes, collider=collider)
+    assert g.laid == [pc.name for pc in pattern.pieces if pc.placement] and "first try" in g.timings
+    assert on_body_failures(g, body, surface=surface) == []
+    assert target_misses(g, QualityTargets.robust()) == []

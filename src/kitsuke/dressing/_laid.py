@@ -8,6 +8,12 @@ one stroke, on the back: the front ended at the back right or left, `outcome.wro
 laid instead where the pattern's placement puts it, turned about the body's vertical axis and moved up or down as
 the stroked pieces were placed (GarmentCode lays each panel flat around the body, the front in front of it), and
 its seams are closed from there like any other: the close pulls its edges round to the neighbours it is sewn to.
+
+The same answers cloth torn round a limb: growing a bodice from a stroke on the chest takes its side over the upper
+arm, and the side seam then closes with the arm inside the torso. Every piece laid at its placement (the stroke
+triangles still on their strokes) and sewn by the close puts the side seam under the arm, as GarmentCode's own
+simulator does from the same placement (measured: a sleeveless fitted dress, torn at the armpit when grown, worn
+with the arms through its armholes when laid).
 """
 
 from __future__ import annotations

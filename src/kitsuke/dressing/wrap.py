@@ -13,8 +13,10 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
 2. **Growth** (`_grow`): the rest of the garment grows ring by ring from the placed triangles, each new triangle
    unfolded from its placed neighbour (from the cloth, not the body), with relaxation and collision between rings.
    The stroke triangles stay pinned while the garment grows. Pieces named in `grow.laid` are not grown but laid
-   where the pattern's placement puts them (`_laid`); a wrap whose result has a piece without strokes on the wrong
-   side of the body (`outcome.wrong_side_pieces`) lays those pieces and dresses once more (`grow.relay`).
+   where the pattern's placement puts them (`_laid`; "*": every placed piece); a wrap whose result has a piece
+   without strokes on the wrong side of the body (`outcome.wrong_side_pieces`) lays those pieces and dresses once
+   more, and one that fails otherwise (torn round a limb, off the body) dresses once more with every placed piece
+   laid (`grow.relay`).
 3. **Seams**: the garment mesh shares the vertices of every seam from the start (`_weld`; corners where two seams
    of one piece meet are repaired first, `repair_corners`), so where two grown regions meet at a seam the
    triangles between them are stretched. A closing relaxation without gravity (`_solve.GlobalRelax`: a global
@@ -322,10 +324,11 @@ def wrap(
     placements = None if pattern is None else {pc.name: pc.placement for pc in pattern.pieces if pc.placement}
     placement = place_strokes(pm, welded, strokes, surface, collider, lift_m=p.grow.lift_m, placements=placements)
     seed_pins = placement.placed.copy()  # the stroke triangles' vertices, held while the garment grows
-    unknown = sorted(set(p.grow.laid) - set(pm.piece_names))
+    unknown = sorted(set(p.grow.laid) - set(pm.piece_names) - {"*"})
     if unknown:
         raise InputError(f"grow.laid names no piece {', '.join(map(repr, unknown))} of pattern {pm.name!r}")
-    laid = [k for k, name in enumerate(pm.piece_names) if name in p.grow.laid and pm.placed[k]]
+    every = "*" in p.grow.laid
+    laid = [k for k, name in enumerate(pm.piece_names) if (every or name in p.grow.laid) and pm.placed[k]]
     if laid:
         placement = lay_at_placement(pm, welded, placement, laid, body_axis(mesh))
     grow_params = dataclasses.replace(p.cloth, gravity_step_m=0.0)
@@ -491,10 +494,13 @@ def wrap(
             more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
             failure = ComputationError("wrap", f"not a garment on the body: {bad[0]}{more}", result=result)
             wrong = [pm.piece_names[k] for k, _ in wrong_side_pieces(result, mesh) if k not in laid]
-            if not (p.grow.relay and wrong):
+            if not p.grow.relay or (not wrong and (every or not pm.placed.any())):
                 raise failure
-            say(f"laying {', '.join(wrong)} at the placement")
-            again = p.changed({"grow.laid": tuple(p.grow.laid) + tuple(wrong)})
+            # Pieces growth took to the wrong side are laid at their placement; a failure without such a piece
+            # (cloth torn round a limb, a piece off the body) is dressed once more with every placed piece laid.
+            again_laid = tuple(p.grow.laid) + tuple(wrong) if wrong else ("*",)
+            say(f"laying {', '.join(wrong) or 'every piece'} at the placement")
+            again = p.changed({"grow.laid": again_laid})
             try:
                 redone = wrap(
                     body,

@@ -88,10 +88,13 @@ class GrowSettings:
         grown over the hips drapes round both legs. None: when the garment has an opening below the crotch that
         goes round both legs (`_bridge.spans_legs`: a skirt's hem, not a trouser leg's); True / False: always /
         never.
-    laid : names of pieces without strokes laid where the pattern's placement puts them (turned and moved as the
-        stroked pieces were) instead of grown (`_laid`); pieces without a placement are grown.
+    laid : names of pieces laid where the pattern's placement puts them (turned and moved as the stroked pieces
+        were; a piece's stroke triangles stay on its strokes) instead of grown (`_laid`); "*": every piece with a
+        placement. Pieces without a placement are grown.
     relay : when growth takes a piece without strokes to the wrong side of the body (`outcome.wrong_side_pieces`),
-        dress once more with it laid (added to `laid`), while that finds new pieces.
+        dress once more with it laid (added to `laid`), while that finds new pieces; when the wrap fails
+        otherwise (`outcome.on_body_failures`: torn cloth, a piece off the body), dress once more with every
+        placed piece laid ("*").
     """
 
     lift_m: float = 0.004
