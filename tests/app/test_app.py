@@ -603,6 +603,13 @@ def test_edit_points_in_the_browser(app_page, tmp_path):
     px = app_page.screen(board.to_board(piece, points[new_point : new_point + 1]) + [0, 0, 0.01])
     page.mouse.click(float(px[0, 0]), float(px[0, 1]))
     page.wait_for_timeout(800)
+    if view.tools.selected_point != (piece, new_point):
+        # On a loaded machine the browser can still hold the handles drawn before the split (their clicks name the
+        # old points): once it has the new ones, the same click selects the new point.
+        page.wait_for_timeout(1500)
+        view.tools.selected_point = None
+        page.mouse.click(float(px[0, 0]), float(px[0, 1]))
+        page.wait_for_timeout(800)
     assert view.tools.selected_point == (piece, new_point)
     page.get_by_role("button", name="Delete point").click()
     page.wait_for_timeout(800)
