@@ -128,7 +128,9 @@ class DressedGarment:
     gathers : the seams whose longer side was gathered onto the shorter (`WrapParams.gather`): the model's rest
         shape is gathered there, and strain is measured against it.
     laid : pieces laid at their placement instead of grown (`GrowSettings.laid`; by the wrap itself where growth
-        took them to the wrong side of the body, the first try's time in timings["first try"]).
+        took them to the wrong side of the body or failed otherwise, the first try's time in timings["first
+        try"]). redone_after : why the wrap dressed the garment once more (`GrowSettings.relay`): the first
+        try's failure, one line; "" when the first try was kept.
     rings : growth rings. mend : what `_mend.mend_tears` did after the close (rounds, torn edges before and
         after). polished : the polish's result was kept (`PolishSettings.rounds`). timings : seconds per step
         ("mesh", "resolve", "place", "grow", "close", "settle", "finish", "untangle", "polish", "wrap" = all of
@@ -153,6 +155,7 @@ class DressedGarment:
     loose_strokes: list[int] = field(default_factory=list)
     gathers: list[Gather] = field(default_factory=list)
     laid: list[str] = field(default_factory=list)
+    redone_after: str = ""
     rings: int = 0
     mend: MendStats = field(default_factory=MendStats)
     polished: bool = False
@@ -184,6 +187,7 @@ class DressedGarment:
             "loose_strokes": list(self.loose_strokes),
             "gathered_seams": [dataclasses.asdict(g) | {"ratio": round(g.ratio, 4)} for g in self.gathers],
             "laid_pieces": list(self.laid),
+            "redone_after": self.redone_after,
             "timings_s": {k: round(v, 4) for k, v in self.timings.items()},
             "strokes": [
                 {
@@ -515,6 +519,7 @@ def wrap(
             except ComputationError:
                 raise failure from None
             redone.timings["first try"] = timings["wrap"]
+            redone.redone_after = failure.message  # the first try's (an inner relay set its own)
             return redone
     return result
 
