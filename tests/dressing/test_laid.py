@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import zlib
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -81,19 +82,26 @@ def test_laid_takes_piece_names():
         WrapParams().changed({"grow.laid": (1, 2)})
 
 
+def _on_mean_all(path: Path) -> tuple:
+    """A tests-corpus design on mean_all with its suggested strokes perturbed as the corpus test perturbs them:
+    (body, collider, surface, pattern, strokes)."""
+    body = load_body(DATA / "bodies" / "mean_all.obj")
+    collider = BodyCollider.from_body(body)
+    surface = collider.surface_for(body.mesh)
+    pattern = load_pattern(path)
+    name = path.stem.replace("_specification", "")
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    strokes = perturb_strokes(suggest_strokes(body, pattern, surface=surface), surface, rng)
+    return body, collider, surface, pattern, strokes
+
+
 @pytest.fixture(scope="module")
 def skirt_on_back_stroke():
     """GarmentCode's skirt with a waistband (tests corpus) on mean_all, from its suggested strokes as a hand drew
     them: the front's stroke is the one left out, so only the back is stroked."""
-    body = load_body(DATA / "bodies" / "mean_all.obj")
-    collider = BodyCollider.from_body(body)
-    surface = collider.surface_for(body.mesh)
-    pattern = load_pattern(SKIRT)
-    name = SKIRT.stem.replace("_specification", "")
-    rng = np.random.default_rng(zlib.crc32(name.encode()))
-    strokes = perturb_strokes(suggest_strokes(body, pattern, surface=surface), surface, rng)
-    assert [p.pattern.piece for p in strokes.pairs] == ["skirt_back"]
-    return body, collider, surface, pattern, strokes
+    dressing = _on_mean_all(SKIRT)
+    assert [p.pattern.piece for p in dressing[-1].pairs] == ["skirt_back"]
+    return dressing
 
 
 @pytest.mark.slow
@@ -136,13 +144,7 @@ def test_a_shirt_growth_tears_is_dressed_with_every_piece_laid(run_cli, tmp_path
     goes over the upper arm and the side seam closes with the arm inside the torso, and the wrap fails; dressed
     once more with every piece laid at its placement and sewn by the close, it is worn within the targets.
     `kitsuke dress` says why it dressed twice."""
-    body = load_body(DATA / "bodies" / "mean_all.obj")
-    collider = BodyCollider.from_body(body)
-    surface = collider.surface_for(body.mesh)
-    pattern = load_pattern(TORN_SHIRT)
-    name = TORN_SHIRT.stem.replace("_specification", "")
-    rng = np.random.default_rng(zlib.crc32(name.encode()))
-    strokes = perturb_strokes(suggest_strokes(body, pattern, surface=surface), surface, rng)
+    body, collider, _, pattern, strokes = _on_mean_all(TORN_SHIRT)
     with pytest.raises(ComputationError, match="wrap: not a garment on the body") as first:
         wrap(body, pattern, strokes, collider=collider, params=WrapParams().changed({"grow.relay": False}))
     write_strokes(strokes, tmp_path / "strokes.json")

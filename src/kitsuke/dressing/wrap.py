@@ -128,7 +128,7 @@ class DressedGarment:
     gathers : the seams whose longer side was gathered onto the shorter (`WrapParams.gather`): the model's rest
         shape is gathered there, and strain is measured against it.
     laid : pieces laid at their placement instead of grown (`GrowSettings.laid`; by the wrap itself where growth
-        took them to the wrong side of the body or failed otherwise, the first try's time in timings["first
+        took them to the wrong side of the body or failed otherwise, the earlier tries' time in timings["first
         try"]). redone_after : why the wrap dressed the garment once more (`GrowSettings.relay`): the first
         try's failure, one line; "" when the first try was kept.
     rings : growth rings. mend : what `_mend.mend_tears` did after the close (rounds, torn edges before and
@@ -518,7 +518,7 @@ def wrap(
                 )
             except ComputationError:
                 raise failure from None
-            redone.timings["first try"] = timings["wrap"]
+            redone.timings["first try"] = timings["wrap"] + redone.timings.get("first try", 0.0)  # all earlier tries
             redone.redone_after = failure.message  # the first try's (an inner relay set its own)
             return redone
     return result
