@@ -60,6 +60,21 @@ class AppPage:
         if close.count():  # viser's "software WebGL" notice swallows clicks under it
             close.first.click()
 
+    def until(self, condition, what: str, timeout: float = 20.0) -> None:  # noqa: ANN001
+        """Wait (polling the app's own state) until `condition()` holds: the page's events reach the server on its
+        own threads, later on a loaded machine than a fixed pause allows."""
+        t0 = time.monotonic()
+        while not condition():
+            if time.monotonic() - t0 > timeout:
+                raise TimeoutError(f"after {timeout:.0f} s: {what}")
+            self.page.wait_for_timeout(100)
+
+    def tick(self, label: str, checkbox) -> None:  # noqa: ANN001
+        """Click a checkbox by its label and wait until the server sees it flipped."""
+        before = checkbox.value
+        self.page.get_by_text(label).click()
+        self.until(lambda: checkbox.value != before, f"the server never saw {label!r} change")
+
     def picture(self, path) -> None:  # noqa: ANN001
         """A screenshot for the README, without notices over the scene."""
         for button in self.page.locator("button.mantine-Notification-closeButton").all():

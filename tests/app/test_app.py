@@ -137,14 +137,16 @@ def test_draw_a_stroke_pair_with_the_mouse(app_page):
     on_board = view.board.to_board("migoro_right", piece_pts)
     app_page.drag(on_board)
     s = view.session
-    assert s.pending is not None and s.pending.piece == "migoro_right"
+    app_page.until(lambda: s.pending is not None, "the pattern stroke never arrived")
+    assert s.pending.piece == "migoro_right"
     got = view.session.pattern.file_to_piece("migoro_right", s.pending.points)
     # within 1.5 cm of the drawn line, along most of it
     assert np.abs(got[:, 0] - 15.0).max() < 1.5
     assert got[:, 1].min() < 125 and got[:, 1].max() > 155
     body_pts = _front_of_body(view.session.body, 0.06, np.linspace(1.0, 1.3, 5))
     app_page.drag(body_pts)
-    assert len(s.pairs) == 1 and s.pending is None
+    app_page.until(lambda: len(s.pairs) == 1, "the body stroke never made a pair")
+    assert s.pending is None
     pair = s.pairs[0]
     assert pair.id == 1
     near = Surface(view.session.body.mesh).closest(pair.body.surface_points)
@@ -153,14 +155,14 @@ def test_draw_a_stroke_pair_with_the_mouse(app_page):
     assert pair.body.surface_points[:, 1].min() < 1.06 and pair.body.surface_points[:, 1].max() > 1.24
     app_page.page.get_by_text("1 stroke pair(s)").wait_for(timeout=15000)
     app_page.page.get_by_role("button", name="Undo", exact=True).click()
-    app_page.page.wait_for_timeout(500)
-    assert len(s.pairs) == 0
+    app_page.until(lambda: len(s.pairs) == 0, "Undo never removed the pair")
     app_page.page.get_by_role("button", name="Redo", exact=True).click()
-    app_page.page.wait_for_timeout(500)
-    assert [p.id for p in s.pairs] == [1] and view.pair_choice.value == "1"
+    app_page.until(lambda: len(s.pairs) == 1, "Redo never brought the pair back")
+    app_page.until(lambda: view.pair_choice.value == "1", "the pair list never showed pair 1")
+    assert [p.id for p in s.pairs] == [1]
     app_page.page.get_by_role("button", name="Redraw pair").click()
-    app_page.page.wait_for_timeout(500)
-    assert s.pairs == [] and s.next_id() == 1
+    app_page.until(lambda: s.pairs == [], "Redraw pair never removed the pair")
+    assert s.next_id() == 1
     assert all(u.startswith(("http://127.0.0.1", "ws://127.0.0.1", "data:", "blob:")) for u in app_page.requests)
 
 
@@ -181,12 +183,15 @@ def test_wrap_in_the_browser_then_save_the_garment(app_page, tmp_path):
     g = _wrap(app_page)
     assert g is not None and view.outcome.startswith("Dressed")
     assert view.garment_handle.visible
-    page.wait_for_timeout(1500)
-    after = np.asarray(Image.open(io.BytesIO(page.screenshot())))
     # where the body's trunk is on screen, the picture changed (the garment covers it)
     cx, cy = app_page.screen(np.array([[0.0, 1.1, 0.15]]))[0].astype(int)
     patch = (slice(cy - 30, cy + 30), slice(cx - 30, cx + 30))
-    assert np.abs(after[patch].astype(int) - before[patch].astype(int)).mean() > 20
+
+    def covered() -> bool:
+        after = np.asarray(Image.open(io.BytesIO(page.screenshot())))
+        return np.abs(after[patch].astype(int) - before[patch].astype(int)).mean() > 20
+
+    app_page.until(covered, "the garment never appeared on screen over the trunk")
     # the README's picture of the app (KITSUKE_APP_SCREENSHOTS=docs pytest tests/app -k wrap rebuilds it)
     shots = Path(os.environ.get("KITSUKE_APP_SCREENSHOTS", tmp_path))
     app_page.picture(shots / "app_kimono_dressed.png")
@@ -203,12 +208,10 @@ def test_wrap_in_the_browser_then_save_the_garment(app_page, tmp_path):
     steps = drags_from_dict(json.loads(open(downloads.pop().path()).read())).steps
     assert [(s.grab is not None, s.pins is not None) for s in steps] == [(True, False), (False, True)]
     # the strain map replaces the plain garment while ticked
-    page.get_by_text("Show strain").click()
-    page.wait_for_timeout(800)
-    assert view.garment_handle.visible is False
-    page.get_by_text("Show strain").click()
-    page.wait_for_timeout(300)
-    assert view.garment_handle.visible is True
+    app_page.tick("Show strain", view.strain_box)
+    app_page.until(lambda: view.garment_handle.visible is False, "the strain map never replaced the garment")
+    app_page.tick("Show strain", view.strain_box)
+    app_page.until(lambda: view.garment_handle.visible is True, "the plain garment never came back")
     _rewrap(app_page)
     page.get_by_role("button", name="Save garment (GLB, OBJ, report)").click()
     for _ in range(100):
@@ -264,18 +267,18 @@ def _wait_idle(app_page) -> None:
 def _rewrap(app_page) -> None:
     """Re-wrap: a stroke on the right front panel, its partner drawn on the garment 4 cm to the side; the cloth
     along the pattern stroke moves toward it, the pin still holds."""
-    view, page = app_page.view, app_page.page
+    view = app_page.view
     d = view.dragging
     pinned = np.flatnonzero(d.pinned)
     held = d.positions[pinned].copy()
     before = d.positions.copy()
-    page.get_by_text("Click to pin / unpin").click()  # off again
-    page.get_by_text("Draw on the garment (re-wrap)").click()
-    page.wait_for_timeout(300)
+    app_page.tick("Click to pin / unpin", view.pin_mode)  # off again
+    app_page.tick("Draw on the garment (re-wrap)", view.rewrap_mode)
     app_page.drag(view.board.to_board("migoro_right", np.array([[15.0, y] for y in (120.0, 135.0, 150.0)])))
+    app_page.until(lambda: view.session.pending is not None, "the pattern stroke never arrived")
     top = _front_of(d.positions, d.model.faces, -0.02, 1.0)
     app_page.drag(np.array([top + [0, dy, 0] for dy in (0.0, -0.05, -0.1)]))
-    assert len(view.session.garment_pairs) == 1
+    app_page.until(lambda: len(view.session.garment_pairs) == 1, "the garment stroke never made a pair")
     _press_and_wait(app_page, "Re-wrap")
     assert view.dragging is not d
     new = view.dragging.positions
@@ -300,13 +303,11 @@ def _drag_and_pin(app_page) -> None:
     assert d.positions[grabbed_near, 1] > start[1] + 0.04  # cloth rose with the pointer
     assert len(view.dragger.update_s) >= 2
     # pin: the pin mode, a click on the garment's left front; then a drag on the right front
-    page.get_by_text("Click to pin / unpin").click()
-    page.wait_for_timeout(300)
+    app_page.tick("Click to pin / unpin", view.pin_mode)
     pin_at = _front_of(d.positions, d.model.faces, -0.12, 0.9)
     px = app_page.screen(pin_at[None])[0]
     page.mouse.click(float(px[0]), float(px[1]))
-    page.wait_for_timeout(800)
-    assert d.pinned.sum() == 1
+    app_page.until(lambda: d.pinned.sum() == 1, "the click never pinned a point")
     pinned = np.flatnonzero(d.pinned)[0]
     held = d.positions[pinned].copy()
     start = _front_of(d.positions, d.model.faces, 0.1, 0.7)
@@ -314,7 +315,7 @@ def _drag_and_pin(app_page) -> None:
     _wait_idle(app_page)
     assert np.linalg.norm(d.positions[pinned] - held) < 2e-3  # the pin held
     page.get_by_role("button", name="Undo drag").click()
-    page.wait_for_timeout(500)
+    app_page.until(lambda: not view.dragger.busy and not view.dragger._ops, "Undo drag never finished")
     assert d.pinned.sum() == 1
 
 
@@ -355,17 +356,11 @@ def test_open_a_garmentcode_shirt_and_suggest_strokes(app_page):
     shirt = Path(__file__).parent.parent / "data" / "pattern" / "shirt_mean_specification.json"
     page = app_page.page
     page.locator("input[type=file]").nth(1).set_input_files(str(shirt))
-    for _ in range(100):
-        if "right_ftorso" in app_page.view.board.places:
-            break
-        page.wait_for_timeout(100)
     view = app_page.view
+    app_page.until(lambda: "right_ftorso" in view.board.places, "the shirt never reached the board")
     assert set(view.board.places) == set(view.session.pattern.piece_names) and len(view.board.places) == 8
     page.get_by_role("button", name="Suggest strokes").click()
-    for _ in range(100):
-        if view.session.pairs:
-            break
-        page.wait_for_timeout(100)
+    app_page.until(lambda: view.session.pairs, "Suggest strokes never made pairs")
     assert len(view.session.pairs) == 8
     page.get_by_text("8 stroke pair(s)").wait_for(timeout=15000)  # the panel says so
     # one pair redrawn by hand (a front one: its body stroke faces the camera), then the shirt wrapped
@@ -374,10 +369,11 @@ def test_open_a_garmentcode_shirt_and_suggest_strokes(app_page):
     body_pts = front.body.surface_points + [0, 0, 0.01]
     view.pair_choice.value = str(front.id)
     page.get_by_role("button", name="Redraw pair").click()
-    page.wait_for_timeout(500)
-    assert front.id not in [p.id for p in view.session.pairs]
+    app_page.until(lambda: front.id not in [p.id for p in view.session.pairs], "Redraw pair never removed it")
     app_page.drag(pattern_pts[:: max(1, len(pattern_pts) // 4)])
+    app_page.until(lambda: view.session.pending is not None, "the pattern stroke never arrived")
     app_page.drag(body_pts[:: max(1, len(body_pts) // 4)])
+    app_page.until(lambda: front.id in [p.id for p in view.session.pairs], "the redrawn pair never arrived")
     redrawn = next(p for p in view.session.pairs if p.id == front.id)
     assert redrawn.pattern.piece == front.pattern.piece
     assert np.linalg.norm(redrawn.body.surface_points.mean(0) - front.body.surface_points.mean(0)) < 0.03
@@ -430,15 +426,15 @@ def test_session_laser_stroke_lands_front_and_back(body, kimono):
 
 def test_laser_stroke_in_the_browser(app_page):
     """Two pattern strokes, the laser ticked, one drag across the body: two pairs, on the front and on the back."""
-    view, page = app_page.view, app_page.page
+    view = app_page.view
     app_page.drag(view.board.to_board("migoro_right", np.array([[15.0, y] for y in (110.0, 130.0, 150.0)])))
     app_page.drag(view.board.to_board("migoro_left", np.array([[15.0, y] for y in (190.0, 210.0, 230.0)])))
-    page.get_by_text("Laser (front and back)").click()
-    page.wait_for_timeout(300)
+    app_page.until(lambda: len(view.session.waiting) == 2, "the two pattern strokes never arrived")
+    app_page.tick("Laser (front and back)", view.laser)
     across = _front_of_body(view.session.body, 0.0, np.array([1.2]))[0]
     app_page.drag(np.array([across + [dx, 0, 0] for dx in (-0.08, -0.03, 0.02, 0.07)]))
+    app_page.until(lambda: len(view.session.pairs) == 2, "the laser stroke never made two pairs")
     pairs = view.session.pairs
-    assert len(pairs) == 2
     assert (pairs[0].body.surface_points[:, 2] > 0.05).all()  # entered at the front
     assert (pairs[1].body.surface_points[:, 2] < 0.05).all()  # left at the back
 
@@ -514,51 +510,47 @@ def test_a_skirt_from_nothing_in_the_browser(app_page):
     view, page = app_page.view, app_page.page
     page.get_by_text("Edit the pattern").click()
     page.get_by_role("button", name="New empty pattern").click()
-    page.wait_for_timeout(800)
-    assert view.session.pattern.pieces == []
-    page.get_by_text("Draw a piece: click its corners").click()
-    page.wait_for_timeout(300)
+    app_page.until(lambda: view.session.pattern.pieces == [], "New empty pattern never emptied the board")
+    app_page.tick("Draw a piece: click its corners", view.tools.piece_mode)
     z = view.board.z
     for x, y in ((0.8, 1.2), (1.1, 1.2), (1.1, 1.5), (0.8, 1.5)):
         px = app_page.screen(np.array([[x, y, z]]))[0]
+        n = len(view.tools.corners)
         page.mouse.click(float(px[0]), float(px[1]))
-        page.wait_for_timeout(250)
-    assert len(view.tools.corners) == 4
+        app_page.until(lambda n=n: len(view.tools.corners) == n + 1, "a corner click never arrived")
     page.get_by_role("button", name="Close the piece").click()
-    page.wait_for_timeout(800)
-    assert view.session.pattern.piece_names == ["piece1"]
+    app_page.until(lambda: view.session.pattern.piece_names == ["piece1"], "Close the piece never made a piece")
     w, h = view.session.pattern.piece("piece1").bounds[1]
     assert abs(w - 60) < 4 and abs(h - 60) < 4  # 0.3 m on the board = 60 cm of pattern
-    page.get_by_text("Draw a piece: click its corners").click()  # off
+    app_page.tick("Draw a piece: click its corners", view.tools.piece_mode)  # off
     page.get_by_role("button", name="Duplicate piece").click()
-    page.wait_for_timeout(800)
-    assert len(view.session.pattern.pieces) == 2
-    page.get_by_text("Sew: click two edges").click()
-    page.wait_for_timeout(300)
+    app_page.until(lambda: len(view.session.pattern.pieces) == 2, "Duplicate piece never made a second piece")
+    app_page.tick("Sew: click two edges", view.tools.sew_mode)
     a, b = view.session.pattern.piece_names
     for piece, pt in ((a, [w, h / 2]), (b, [0.0, h / 2])):  # a's right side, b's left side
         px = app_page.screen(view.board.to_board(piece, np.array([pt]) + [[-1.0 if piece == a else 1.0, 0]]))[0]
         page.mouse.click(float(px[0]), float(px[1]))
         page.wait_for_timeout(500)
+    app_page.until(lambda: len(view.session.pattern.seams) == 1, "two edge clicks never sewed a seam")
     seams = view.session.pattern.seams
-    assert len(seams) == 1
     assert {seams[0].a.piece, seams[0].b.piece} == {a, b}
     for piece, pt in ((a, [0.0, h / 2]), (b, [w, h / 2])):  # and a's left side to b's right
         px = app_page.screen(view.board.to_board(piece, np.array([pt]) + [[1.0 if piece == a else -1.0, 0]]))[0]
         page.mouse.click(float(px[0]), float(px[1]))
         page.wait_for_timeout(500)
-    assert len(view.session.pattern.seams) == 2
-    page.get_by_text("Sew: click two edges").click()  # off
+    app_page.until(lambda: len(view.session.pattern.seams) == 2, "two edge clicks never sewed a second seam")
+    app_page.tick("Sew: click two edges", view.tools.sew_mode)  # off
     # a stroke along each piece's top, the back's drawn right to left (as it lies seen from behind); one laser
     # stroke across the waist lands on the front and the back
     y = h - 12.0
     app_page.drag(view.board.to_board(a, np.array([[x, y] for x in (w * 0.25, w * 0.5, w * 0.75)])))
+    app_page.until(lambda: view.session.pending is not None, "the first pattern stroke never arrived")
     app_page.drag(view.board.to_board(b, np.array([[x, y] for x in (w * 0.75, w * 0.5, w * 0.25)])))
-    page.get_by_text("Laser (front and back)").click()
-    page.wait_for_timeout(300)
+    app_page.until(lambda: len(view.session.waiting) == 2, "the second pattern stroke never arrived")
+    app_page.tick("Laser (front and back)", view.laser)
     across = _front_of_body(view.session.body, 0.0, np.array([0.95]))[0]
     app_page.drag(np.array([across + [dx, 0, 0] for dx in (-0.1, -0.03, 0.03, 0.1)]))
-    assert len(view.session.pairs) == 2
+    app_page.until(lambda: len(view.session.pairs) == 2, "the laser stroke never made two pairs")
     g = _wrap(app_page)
     lo, hi = g.positions.min(axis=0), g.positions.max(axis=0)
     assert 0.85 < hi[1] < 1.15 and lo[1] > 0.3  # from the waist down, not to the floor
@@ -571,8 +563,8 @@ def test_edit_points_in_the_browser(app_page, tmp_path):
     seam: each a browser gesture, each checked on the server's pattern."""
     view, page = app_page.view, app_page.page
     page.get_by_text("Edit the pattern").click()
-    page.get_by_text("Edit points").click()
-    page.wait_for_timeout(800)
+    app_page.tick("Edit points", view.tools.point_mode)
+    page.wait_for_timeout(500)  # the handles drawn
     piece = view.session.pattern.piece_names[0]
     board = view.board
     points, middles = view.editor.handles(piece)
@@ -601,15 +593,18 @@ def test_edit_points_in_the_browser(app_page, tmp_path):
     new_point = bottom + 1  # the hem was split: its new point follows the hem's start
     assert abs(points[new_point, 1] - bent.edge_points(bottom, np.array([0.3]))[0, 1]) < 1.0
     px = app_page.screen(board.to_board(piece, points[new_point : new_point + 1]) + [0, 0, 0.01])
-    page.mouse.click(float(px[0, 0]), float(px[0, 1]))
-    page.wait_for_timeout(800)
-    if view.tools.selected_point != (piece, new_point):
-        # On a loaded machine the browser can still hold the handles drawn before the split (their clicks name the
-        # old points): once it has the new ones, the same click selects the new point.
-        page.wait_for_timeout(1500)
+    # On a loaded machine the browser can still hold the handles drawn before the split (their clicks name the old
+    # points): once it has the new ones, the same click selects the new point.
+    for _ in range(10):
         view.tools.selected_point = None
         page.mouse.click(float(px[0, 0]), float(px[0, 1]))
-        page.wait_for_timeout(800)
+        try:
+            app_page.until(lambda: view.tools.selected_point is not None, "", timeout=3.0)
+        except TimeoutError:
+            continue
+        if view.tools.selected_point == (piece, new_point):
+            break
+        page.wait_for_timeout(1000)
     assert view.tools.selected_point == (piece, new_point)
     page.get_by_role("button", name="Delete point").click()
     page.wait_for_timeout(800)

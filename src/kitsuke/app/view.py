@@ -404,18 +404,19 @@ class ClientView:
                 now = f"{stage[0]}, " if stage[0] else ""
                 note.body = f"{now}{time.monotonic() - t0:.0f} s (Cancel wrap stops it)"
 
-        threading.Thread(target=tick, daemon=True).start()
+        ticker = threading.Thread(target=tick, daemon=True)
+        ticker.start()
         try:
             result = compute(lambda name: stage.__setitem__(0, name))
         except Cancelled:
-            self._job_ended(note, ticking, f"{title} cancelled", "Nothing changed.", "yellow")
+            self._job_ended(note, ticker, ticking, f"{title} cancelled", "Nothing changed.", "yellow")
             return
         except (InputError, ComputationError) as e:
             reason = e.message if isinstance(e, InputError) else f"{e.stage}: {e.message}"
-            self._job_ended(note, ticking, f"{title} failed", reason, "red")
+            self._job_ended(note, ticker, ticking, f"{title} failed", reason, "red")
             return
         title, body, color = done(result)
-        self._job_ended(note, ticking, title, body, color)
+        self._job_ended(note, ticker, ticking, title, body, color)
         self.status_line(body)
 
     def _wrapped(self, garment) -> tuple[str, str, str]:  # noqa: ANN001 - a DressedGarment
@@ -564,8 +565,17 @@ class ClientView:
             self._show_pins()
             self.show_strain()
 
-    def _job_ended(self, note, ticking: threading.Event, title: str, body: str, color: str) -> None:  # noqa: ANN001
+    def _job_ended(  # noqa: PLR0913
+        self,
+        note,
+        ticker: threading.Thread,
+        ticking: threading.Event,
+        title: str,
+        body: str,
+        color: str,  # noqa: ANN001
+    ) -> None:
         ticking.set()
+        ticker.join()  # its last update must not land on the removed notice
         note.remove()
         self.notify(title, body, color)
         self.outcome = f"{title}: {body}"  # the last wrap's or re-wrap's, as said to the user
