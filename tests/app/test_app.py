@@ -564,15 +564,20 @@ def test_edit_points_in_the_browser(app_page, tmp_path):
     view, page = app_page.view, app_page.page
     page.get_by_text("Edit the pattern").click()
     app_page.tick("Edit points", view.tools.point_mode)
-    page.wait_for_timeout(500)  # the handles drawn
     piece = view.session.pattern.piece_names[0]
     board = view.board
     points, middles = view.editor.handles(piece)
     top = int(np.argmax(middles[:, 1]))  # the piece's top edge
     start = board.to_board(piece, middles[top : top + 1])[0] + [0, 0, 0.01]
     end = start + [0, 0.05, 0]  # 10 cm of pattern upwards
-    app_page.drag(np.array([start, start + [0, 0.02, 0], end]))
-    page.wait_for_timeout(800)
+    for _ in range(5):  # a drag that starts before the browser has drawn the handles misses them: again
+        page.wait_for_timeout(800)
+        app_page.drag(np.array([start, start + [0, 0.02, 0], end]))
+        try:
+            app_page.until(lambda: top in view.session.pattern.piece(piece).curves, "", timeout=5.0)
+            break
+        except TimeoutError:
+            continue
     bent = view.session.pattern.piece(piece)
     assert top in bent.curves
     mid = bent.edge_points(top, np.array([0.5]))[0]
