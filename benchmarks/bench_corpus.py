@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import subprocess
 import sys
 import tempfile
@@ -47,6 +48,8 @@ ROOT = Path(__file__).resolve().parents[1]
 SAMPLER = ROOT.parent / "shared" / "tools" / "garment_sampler" / "sample.py"
 BODY = ROOT / "tests" / "data" / "bodies" / "mean_all.obj"
 #: What GarmentCode's sampler imports beyond kitsuke's own dependencies.
+#: How `target_misses` says that the worst strain lies on cloth cut smaller than the body round it.
+CUT_SMALLER = re.compile(r"cut \d+ % smaller than the body")
 SAMPLER_NEEDS = "svgpathtools svgwrite pyyaml psutil cairosvg matplotlib"
 
 
@@ -118,7 +121,8 @@ def dress_one(path: Path, body, collider, surface, rng, perturb: bool, drag: boo
     bad = insane(garment.positions, r.strain_max, surface) + on_body_failures(garment, body, surface=surface)
     misses = target_misses(garment, QualityTargets.robust())
     row["status"] = "garbage" if bad else ("ok" if not misses else "out of target")
-    row["reason"] = "; ".join(bad or misses)[:200]
+    row["reason"] = "; ".join(bad or misses)[:300]
+    row["cut_smaller"] = CUT_SMALLER.search(row["reason"]) is not None
     if drag and not bad:
         row.update(drag_front(garment, body))
     return row
@@ -191,6 +195,7 @@ def dress_batch(paths: list[Path], surface, perturb: bool, runner: str, workers:
                     inverted=m["inverted"],
                     stroke_mm=m["stroke_mm"],
                 )
+                row["cut_smaller"] = CUT_SMALLER.search(row["reason"]) is not None
                 bad = insane(read_garment_obj(out / job.id / "garment.obj").positions, row["strain_max"], surface)
                 if bad:
                     row.update(status="garbage", reason="; ".join(bad))
@@ -312,6 +317,11 @@ def main() -> None:
             f"    {part:16s} {got.count('ok'):3d} / {got.count('out of target'):3d} / "
             f"{got.count('failed') + got.count('refused'):3d}   of {len(got)}"
         )
+    out = [r for r in rows if r["status"] == "out of target"]
+    print(
+        f"  out of target where the worst strain lies on cloth cut 2 % or more smaller than the body round it: "
+        f"{sum(r.get('cut_smaller', False) for r in out)} of {len(out)}"
+    )
     if times:
         print(f"  time: median {np.median(times):.1f} s, worst {max(times):.1f} s")
     if args.drag:

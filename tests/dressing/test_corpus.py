@@ -51,6 +51,8 @@ def _outcome(body, collider, surface, path) -> str:
     # Written: a garment on the body, finite, nowhere torn, every stroke's cloth near it.
     assert on_body_failures(garment, body, surface=surface) == [], name
     assert np.isfinite(garment.positions).all() and garment.report.strain_max < 1.0, name
+    if garment.girth is not None:  # cloth round the body is at least the body's tape girth there
+        assert garment.girth.worn_m >= 0.98 * garment.girth.body_m > 0.3, (name, garment.girth)
     if garment.gathers:  # a later drag rests the cloth gathered, as the wrap did
         drag = DragSession(body, garment, collider=collider)
         np.testing.assert_array_equal(drag.model.rest_lengths, garment.model.rest_lengths)

@@ -171,11 +171,25 @@ def on_body_failures(garment, body, *, surface: Surface | None = None) -> list[s
     return out
 
 
+#: Where the cloth round the body at the worst strain is at least this share shorter than the body's girth,
+#: `target_misses` says so beside the strain (2 %: less is within a tape measure's reading of a body).
+SHORT_SAID = 0.02
+
+
 def target_misses(garment, targets: QualityTargets | None = None) -> list[str]:
     """The quality targets a garment on the body misses, one line each (empty: all met). The report's measures
     are judged against `targets` (default: QualityTargets()), and the strokes against its stroke_residual_mm."""
     t = targets or QualityTargets()
     out = [] if garment.report is None else garment.report.failures(t)
+    girth = getattr(garment, "girth", None)  # a DressedGarment's; a garment read from a file has none
+    if girth is not None and girth.short >= SHORT_SAID:  # the pattern must stretch there, however it is dressed
+        out = [
+            f"{line}; the cloth round the body there is {100 * girth.rest_m:.1f} cm long, the body "
+            f"{100 * girth.body_m:.1f} cm: cut {100 * girth.short:.0f} % smaller than the body"
+            if line.startswith("max edge strain")
+            else line
+            for line in out
+        ]
     far = [
         (sid, res)
         for sid, res in zip(garment.stroke_ids, garment.stroke_residual_m, strict=True)

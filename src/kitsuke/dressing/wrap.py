@@ -74,7 +74,7 @@ from ..body.legs import leg_gap
 from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, RefinedPolish, Tethers
 from ..errors import ComputationError, InputError
 from ..geometry import TriMesh
-from ..metrics import QualityReport, QualityTargets, quality_report, strain
+from ..metrics import Girth, QualityReport, QualityTargets, garment_girth, quality_report, strain
 from ..pattern import Pattern, PatternMesh, face_layers, mesh_pattern
 from ._bridge import bridged, spans_legs
 from ._gather import Gather, gathered_rest
@@ -135,7 +135,9 @@ class DressedGarment:
         after). polished : the polish's result was kept (`PolishSettings.rounds`). timings : seconds per step
         ("mesh", "resolve", "place", "grow", "close", "settle", "finish", "untangle", "polish", "wrap" = all of
         them, "report").
-    report : the SPEC §6 quality report against the body.
+    report : the SPEC §6 quality report against the body. girth : the horizontal loop of cloth through its worst
+        strained edge against the body's girth there (`kitsuke.metrics.garment_girth`: a garment cut smaller than
+        the body must stretch), or None where that cut does not go round the body.
     """
 
     name: str
@@ -161,6 +163,7 @@ class DressedGarment:
     polished: bool = False
     timings: dict[str, float] = field(default_factory=dict)
     report: QualityReport | None = None
+    girth: Girth | None = None
 
     @property
     def n_vertices(self) -> int:
@@ -205,6 +208,7 @@ class DressedGarment:
                 )
             ],
             "quality": None if self.report is None else self.report.to_dict(),
+            "girth_at_worst_strain": None if self.girth is None else self.girth.to_dict(),
             "targets_missed": None if self.report is None else target_misses(self),
         }
 
@@ -491,6 +495,10 @@ def wrap(
             rest_areas=out_model.rest_areas,
             pieces=(result.piece_names, result.piece_faces),
         )
+        if result.report.strain_worst_edges:
+            worst = out_model.edges[result.report.strain_worst_edges[0]]
+            at = state.positions[worst].mean(axis=0)
+            result.girth = garment_girth(state.positions, out_model.faces, out_model.rest_corners, mesh, at)
         timings["report"] = time.perf_counter() - t6
     if check:
         bad = on_body_failures(result, body, surface=surface)

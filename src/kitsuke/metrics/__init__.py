@@ -1,10 +1,12 @@
 """Quality measures of a dressed garment (SPEC §6): penetration, strain, seam gap, inverted triangles, the order of
-layered cloth, and a JSON-ready report with pass/fail per measure against the targets of issue 3.
+layered cloth, a garment's girth against the body's (`garment_girth`), and a JSON-ready report with pass/fail per
+measure against the targets of issue 3.
 
     report = quality_report(positions, faces, body.mesh, rest_lengths=model.rest_lengths)
     report.ok, report.failures(), report.to_dict()
 """
 
+from ._girth import Girth, garment_girth
 from ._layers import layer_crossing_mm, wrong_side_mm
 from ._measures import (
     COLLAPSE_RATIO,
@@ -22,11 +24,13 @@ from ._report import QualityReport, QualityTargets, quality_report
 
 __all__ = [
     "COLLAPSE_RATIO",
+    "Girth",
     "Penetration",
     "QualityReport",
     "QualityTargets",
     "SeamGap",
     "Strain",
+    "garment_girth",
     "inverted_triangles",
     "layer_crossing_mm",
     "mesh_edges",

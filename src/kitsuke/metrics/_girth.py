@@ -1,0 +1,181 @@
+"""How far round a garment goes at one height, at rest and worn, against the body it goes round.
+
+    from kitsuke.metrics import garment_girth
+    g = garment_girth(positions, faces, rest_corners, body_mesh, point)   # Girth or None
+    g.short       # 0.15: the cloth's own length round the body is 15 % less than the body's girth there
+
+A garment cut smaller than the body (GarmentCode's fitted designs have no ease, and a low waistband sits on the
+hips) must stretch to go round it, however it is dressed. Where its worst strain lies, the horizontal loop of
+cloth through that point tells a user whether the pattern or the dressing is to blame: the loop's rest length
+(the pattern's own lengths, summed along the cut) against the body's girth inside it, measured as a tape measure
+would (the perimeter of the convex hull of the body's cross-sections the loop goes round: a loop round both
+thighs spans the gap between them).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry import TriMesh
+
+#: A cut of the cloth open by at most this much (metres: a dart's open end, a seam whose two sides were meshed
+#: apart) still counts as a loop; the gap adds nothing to the cloth's length round it.
+GAP_M = 0.03
+#: Where the cut at the worst edge's height finds no loop (the edge runs along a hem), it is tried this far
+#: below and above, metres.
+NUDGE_M = 0.005
+
+
+@dataclass(frozen=True)
+class Girth:
+    """A closed horizontal loop of cloth round the body.
+
+    height_m : the loop's height (Y), metres. rest_m : the cloth's rest length round it (its pattern's lengths),
+    metres. worn_m : its length round it as worn. body_m : the tape girth of the body inside it, metres.
+    """
+
+    height_m: float
+    rest_m: float
+    worn_m: float
+    body_m: float
+
+    @property
+    def short(self) -> float:
+        """The share by which the cloth round the loop is shorter than the body's girth (negative: longer)."""
+        return 1.0 - self.rest_m / self.body_m
+
+    def to_dict(self) -> dict:
+        return {
+            "height_m": round(self.height_m, 4),
+            "rest_cm": round(100 * self.rest_m, 1),
+            "worn_cm": round(100 * self.worn_m, 1),
+            "body_cm": round(100 * self.body_m, 1),
+            "short": round(self.short, 4),
+        }
+
+
+def _cut(vertices: np.ndarray, faces: np.ndarray, y: float):
+    """The faces crossing the plane Y = y, and for each its two crossing edges: (faces (k,), edges (k, 2, 2) vertex
+    pairs, corner pairs (k, 2, 2) (0-2 within the face), t (k, 2) the crossing's share along each edge)."""
+    s = vertices[faces, 1] - y  # (F, 3)
+    s = np.where(s == 0.0, 1e-12, s)  # a vertex on the plane counts as above it
+    side = s > 0
+    crossing = side.any(axis=1) & ~side.all(axis=1)
+    idx = np.flatnonzero(crossing)
+    differ = side[idx] != np.roll(side[idx], -1, axis=1)  # (k, 3): edge c (corner c to c + 1) crosses; two do
+    first, last = np.argmax(differ, axis=1), 2 - np.argmax(differ[:, ::-1], axis=1)
+    corners = np.stack([np.c_[first, (first + 1) % 3], np.c_[last, (last + 1) % 3]], axis=1)  # (k, 2, 2)
+    a, b = corners[..., 0], corners[..., 1]
+    sa, sb = np.take_along_axis(s[idx], a, axis=1), np.take_along_axis(s[idx], b, axis=1)
+    t = sa / (sa - sb)
+    fv = faces[idx]
+    edges = np.stack([np.take_along_axis(fv, a, axis=1), np.take_along_axis(fv, b, axis=1)], axis=2)
+    return idx, edges, corners, t
+
+
+def _points(vertices: np.ndarray, edges: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """(k, 2, 3) the crossing points on each face's two crossing edges."""
+    return vertices[edges[..., 0]] * (1.0 - t[..., None]) + vertices[edges[..., 1]] * t[..., None]
+
+
+def _loop(edges: np.ndarray, points: np.ndarray, start: int, gap_m: float) -> list[int] | None:
+    """The crossing faces (indices into `edges` (k, 2, 2), crossing points `points` (k, 2, 3)) in order round the
+    closed loop through face `start`, or None where it does not close. Where the cut leaves the cloth (a slit, a
+    dart's open end, a seam whose sides were meshed apart) it goes on from the nearest other such place within
+    `gap_m` metres."""
+    key = np.sort(edges, axis=2)
+    at: dict[tuple[int, int], list[int]] = {}
+    for j in range(len(key)):
+        for e in range(2):
+            at.setdefault((int(key[j, e, 0]), int(key[j, e, 1])), []).append(j)
+    sides = [(j, e) for j in range(len(key)) for e in range(2)]
+    open_sides = [(j, e) for j, e in sides if len(at[(int(key[j, e, 0]), int(key[j, e, 1]))]) == 1]
+    order, seen, j, came = [start], {start}, start, 1
+    for _ in range(len(key)):
+        out = tuple(int(v) for v in key[j, 1 - came])
+        nxt = [m for m in at[out] if m != j]
+        if nxt:
+            j = nxt[0]
+            came = 0 if tuple(int(v) for v in key[j, 0]) == out else 1
+        else:  # off the cloth: on from the nearest place the cut comes back onto it
+            here = points[j, 1 - came]
+            near = [(float(np.linalg.norm(points[m, e] - here)), m, e) for m, e in open_sides if m != j]
+            near = [c for c in near if c[0] <= gap_m and (c[1] not in seen or c[1] == start)]
+            if not near:
+                return None
+            _, j, came = min(near)
+        if j == start:
+            return order
+        if j in seen:
+            return None
+        order.append(j)
+        seen.add(j)
+    return None
+
+
+def _inside(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
+    """(n,) bool: points (n, 2) inside the closed polygon (m, 2) (even-odd rule)."""
+    x, z = points[:, 0][:, None], points[:, 1][:, None]
+    x0, z0 = polygon[:, 0][None], polygon[:, 1][None]
+    x1, z1 = np.roll(polygon[:, 0], -1)[None], np.roll(polygon[:, 1], -1)[None]
+    crosses = (z0 > z) != (z1 > z)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        hit = x < x0 + (z - z0) * (x1 - x0) / (z1 - z0)
+    return (crosses & hit).sum(axis=1) % 2 == 1
+
+
+def _hull_perimeter(points: np.ndarray) -> float:
+    from scipy.spatial import ConvexHull, QhullError
+
+    try:
+        hull = ConvexHull(points)
+    except QhullError:
+        return 0.0
+    ring = points[hull.vertices]
+    return float(np.linalg.norm(ring - np.roll(ring, 1, axis=0), axis=1).sum())
+
+
+def garment_girth(
+    positions: np.ndarray, faces: np.ndarray, rest_corners: np.ndarray, body: TriMesh, point: np.ndarray
+) -> Girth | None:
+    """The horizontal loop of cloth through the face nearest `point` (3,) (metres): its rest and worn lengths and
+    the body's tape girth inside it. positions (V, 3) metres, faces (F, 3), rest_corners (F, 3, 2) metres (each
+    corner's rest position, `ClothModel.rest_corners`). None when the cut there does not close round the body
+    (an open piece, a loop that goes round no part of the body)."""
+    for dy in (0.0, -NUDGE_M, NUDGE_M):  # an edge along a hem is cut again just inside the cloth
+        got = _girth(np.asarray(positions, dtype=np.float64), np.asarray(faces), rest_corners, body, point, dy)
+        if got is not None:
+            return got
+    return None
+
+
+def _girth(pos: np.ndarray, faces: np.ndarray, rest_corners, body: TriMesh, point: np.ndarray, dy: float):  # noqa: ANN001
+    point = np.asarray(point, dtype=np.float64) + [0.0, dy, 0.0]
+    y = float(point[1])
+    idx, edges, corners, t = _cut(pos, faces, y)
+    if len(idx) == 0:
+        return None
+    worn = _points(pos, edges, t)  # (k, 2, 3)
+    start = int(np.argmin(np.linalg.norm(worn.mean(axis=1) - point, axis=1)))
+    order = _loop(edges, worn, start, GAP_M)
+    if order is None:
+        return None
+    o = np.asarray(order)
+    rc = np.asarray(rest_corners)[idx]  # (k, 3, 2)
+    rest = (
+        rc[np.arange(len(idx))[:, None], corners[..., 0]] * (1.0 - t[..., None])
+        + rc[np.arange(len(idx))[:, None], corners[..., 1]] * t[..., None]
+    )
+    rest_m = float(np.linalg.norm(rest[o, 0] - rest[o, 1], axis=1).sum())
+    worn_m = float(np.linalg.norm(worn[o, 0] - worn[o, 1], axis=1).sum())
+    ring = worn[o, 0][:, [0, 2]]
+    b_idx, b_edges, _, b_t = _cut(body.vertices, body.faces, y)
+    if len(b_idx) == 0:
+        return None
+    skin = _points(body.vertices, b_edges, b_t).reshape(-1, 3)[:, [0, 2]]
+    inside = skin[_inside(skin, ring)]
+    if len(inside) < 3:
+        return None
+    return Girth(y, rest_m, worn_m, _hull_perimeter(inside))
