@@ -48,9 +48,9 @@ ROOT = Path(__file__).resolve().parents[1]
 SAMPLER = ROOT.parent / "shared" / "tools" / "garment_sampler" / "sample.py"
 BODY = ROOT / "tests" / "data" / "bodies" / "mean_all.obj"
 #: What GarmentCode's sampler imports beyond kitsuke's own dependencies.
+SAMPLER_NEEDS = "svgpathtools svgwrite pyyaml psutil cairosvg matplotlib"
 #: How `target_misses` says that the worst strain lies on cloth cut smaller than the body round it.
 CUT_SMALLER = re.compile(r"cut \d+ % smaller than the body")
-SAMPLER_NEEDS = "svgpathtools svgwrite pyyaml psutil cairosvg matplotlib"
 
 
 def rng_of(path: Path) -> np.random.Generator:

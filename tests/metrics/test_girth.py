@@ -120,3 +120,12 @@ def test_the_misses_say_a_pattern_cut_smaller_than_the_body():
         strain_line = [m for m in target_misses(garment) if m.startswith("max edge strain")]
         assert strain_line, target_misses(garment)  # stretched or squeezed round the body either way
         assert ("cut 10 % smaller than the body" in strain_line[0]) is said, strain_line
+
+
+def test_a_body_without_thickness_inside_the_loop_has_no_girth():
+    """A loop round a flat sheet (its cut is a line: no area for a tape to go round) gives none, not a division
+    by zero."""
+    corners = np.array([[-0.1, 0.6, 0.0], [0.1, 0.6, 0.0], [0.1, 1.2, 0.0], [-0.1, 1.2, 0.0]])
+    sheet = TriMesh(corners, np.array([[0, 1, 2], [0, 2, 3]]))
+    pos, faces, rest = _tube(0.16, rest_width=0.9)
+    assert garment_girth(pos, faces, rest, sheet, np.array([0.16, 0.9, 0.0])) is None

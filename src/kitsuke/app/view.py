@@ -567,12 +567,12 @@ class ClientView:
 
     def _job_ended(  # noqa: PLR0913
         self,
-        note,
+        note,  # noqa: ANN001 - a viser NotificationHandle
         ticker: threading.Thread,
         ticking: threading.Event,
         title: str,
         body: str,
-        color: str,  # noqa: ANN001
+        color: str,
     ) -> None:
         ticking.set()
         ticker.join()  # its last update must not land on the removed notice

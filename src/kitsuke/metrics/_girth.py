@@ -127,6 +127,7 @@ def _inside(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
 
 
 def _hull_perimeter(points: np.ndarray) -> float:
+    """The perimeter of the convex hull of points (n, 2); 0 where they span no area (all on a line)."""
     from scipy.spatial import ConvexHull, QhullError
 
     try:
@@ -151,7 +152,9 @@ def garment_girth(
     return None
 
 
-def _girth(pos: np.ndarray, faces: np.ndarray, rest_corners, body: TriMesh, point: np.ndarray, dy: float):  # noqa: ANN001
+def _girth(
+    pos: np.ndarray, faces: np.ndarray, rest_corners: np.ndarray, body: TriMesh, point: np.ndarray, dy: float
+) -> Girth | None:
     point = np.asarray(point, dtype=np.float64) + [0.0, dy, 0.0]
     y = float(point[1])
     idx, edges, corners, t = _cut(pos, faces, y)
@@ -176,6 +179,5 @@ def _girth(pos: np.ndarray, faces: np.ndarray, rest_corners, body: TriMesh, poin
         return None
     skin = _points(body.vertices, b_edges, b_t).reshape(-1, 3)[:, [0, 2]]
     inside = skin[_inside(skin, ring)]
-    if len(inside) < 3:
-        return None
-    return Girth(y, rest_m, worn_m, _hull_perimeter(inside))
+    tape = _hull_perimeter(inside) if len(inside) >= 3 else 0.0
+    return Girth(y, rest_m, worn_m, tape) if tape > 0.0 else None
