@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kitsuke.cloth import BodyCollider, ClothModel, ClothParams, ClothState, collide, relax, track
+from kitsuke.cloth import BodyCollider, ClothModel, ClothParams, ClothState, collide, relax, sweep, track
+from kitsuke.cloth._collide import SWEEP_MIN_M
 from kitsuke.cloth import _collide_kernels as CK
 from kitsuke.cloth._shapes import grid_sheet
 from kitsuke.errors import InputError
@@ -175,6 +176,31 @@ def test_push_out_moves_inside_vertices_out_and_keeps_pins(sphere, sphere_collid
     assert penetration(state.positions[6:], sphere, threshold_m=0.0).count == 0
     track(model, state, sphere_collider)
     np.testing.assert_allclose(state.contacts.distance[6:], model.params.contact_offset_m, atol=2e-4)
+
+
+def test_sweep_stops_a_move_that_would_be_pushed_out_through_the_far_side(sphere, sphere_collider):
+    # Moves along x at heights y into a 10 cm sphere from 20 cm before it. Rows 0-4 end 4-8 cm deep past its
+    # middle (the push-out would take them out the far side): cut back to where they went in. Kept: 5 ends past
+    # the sphere (through and out), 6 passes beside it, 7 ends before its middle (pushed back out the near side),
+    # 8 ends 5 mm under the far side (cloth sliding round a body), 9 is short, 10 is held.
+    y = np.array([-0.04, -0.02, 0.0, 0.02, 0.04, 0.0, 0.15, 0.0, 0.0, 0.0, 0.0])
+    before = np.c_[np.full(11, -0.2), y, np.zeros(11)]
+    end_x = np.array([0.05, 0.04, 0.02, 0.04, 0.05, 0.2, 0.2, -0.04, 0.095, 0.0, 0.04])
+    after = np.c_[end_x, y, np.zeros(11)]
+    before[9, 0] = -0.9 * SWEEP_MIN_M
+    movable = np.ones(11, dtype=bool)
+    movable[10] = False
+    swept = after.copy()
+    assert sweep(before, swept.copy(), movable, sphere_collider, below_y=-0.03) == 1  # only the lowest row
+    assert sweep(before, swept, movable, sphere_collider) == 5
+    np.testing.assert_array_equal(swept[5:], after[5:])
+    entry = -np.sqrt(0.1**2 - y[:5] ** 2)  # the sphere's near side (the icosphere's facets lie a little inside it)
+    assert np.all(np.abs(swept[:5, 0] - entry) < 3e-3)
+    # Collision after it keeps them on the side they came from; without the sweep it finishes the move.
+    for positions, side in ((swept, -1), (after, 1)):
+        model, state = point_cloud_model(positions[:6])
+        collide(model, state, sphere_collider)
+        assert np.all(np.sign(state.positions[:5, 0]) == side)
 
 
 def test_capsule_vertices_pushed_to_tapered_surface(rng):

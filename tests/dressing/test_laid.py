@@ -159,3 +159,20 @@ def test_a_shirt_growth_tears_is_dressed_with_every_piece_laid(run_cli, tmp_path
     assert report["laid_pieces"] == [pc.name for pc in pattern.pieces if pc.placement]
     assert report["redone_after"] == first.value.message and "first try" in report["timings_s"]
     assert report["targets_missed"] == []
+
+
+@pytest.mark.slow
+def test_laid_trousers_close_round_the_legs_not_through_them():
+    """GarmentCode lays a trouser leg's back panel 20 cm behind the leg; the close's first step carries its cloth
+    that far, and where it would end deep in the knee nearer the front, the push-out finished the move: the back
+    panel tore round the knee (31 % max strain; 2026-11-27). Swept below the crotch, the cloth stops at the back of
+    the leg and the seams close round it."""
+    body = load_body(DATA / "bodies" / "mean_all.obj")
+    collider = BodyCollider.from_body(body)
+    pattern = load_pattern(DATA / "pattern" / "corpus" / "gc_s101_0006_specification.json")
+    strokes = suggest_strokes(body, pattern, surface=collider.surface_for(body.mesh))
+    laid = WrapParams().changed({"grow.laid": ("*",), "grow.relay": False})
+    garment = wrap(body, pattern, strokes, collider=collider, params=laid)
+    assert garment.laid == [pc.name for pc in pattern.pieces if pc.placement]
+    assert on_body_failures(garment, body) == []
+    assert garment.report.strain_max < 0.1 and garment.report.penetration_count == 0

@@ -127,3 +127,36 @@ def test_gravity_settle_hangs_cloth_without_stretching_it_and_keeps_pins():
     jacobi = ClothState.new(model, start.copy(), pinned=pins)
     relax(model.with_params(ClothParams(max_stretch=None, gravity_step_m=0.002)), jacobi, collider, iterations=40)
     assert settled.mean < 0.5 * strain(jacobi.positions, model.edges, model.rest_lengths).mean
+
+
+def test_a_long_step_does_not_take_cloth_through_the_body():
+    """A sheet 30 cm behind a 10 cm sphere held towards targets 4 cm past the sphere's middle: one step moves it
+    34 cm. Below the sweep's height, the cloth whose target lies deep in the sphere's far half stops at its back,
+    and collision keeps it there (pushed out from where the solve put it, it would come out in front: the close
+    of laid GarmentCode trousers pulled a back panel through the knee so); the rest reaches its targets."""
+    body = sphere()
+    collider = BodyCollider.from_mesh(body)
+    uv, f = grid_sheet(13, 13, 0.02)
+    uv = uv - uv.mean(axis=0)
+    model = ClothModel.from_flat(f, uv, params=ClothParams())
+    start = np.c_[uv, np.full(len(uv), -0.3)]
+    state = ClothState.new(model, start)
+    held = np.ones(model.n_vertices, dtype=bool)
+    # Held hard: the solve alone would carry every vertex the whole way.
+    solver = GlobalRelax(
+        model,
+        np.zeros(model.n_vertices, dtype=bool),
+        held=held,
+        targets=start + [0, 0, 0.34],
+        hold_weight=1e3,
+        sweep_below_y=0.05,  # the upper rows are left alone
+    )
+    solver.step(state, collider)
+    r = np.linalg.norm(uv, axis=1)
+    deep = r < 0.075  # targets more than 1 cm deep in the far half
+    low = uv[:, 1] < 0.04
+    assert (deep & low).sum() > 10 and (deep & (uv[:, 1] > 0.06)).sum() > 3
+    assert np.all(state.positions[deep & low, 2] < 0)
+    assert np.all(state.positions[deep & (uv[:, 1] > 0.06), 2] > 0)  # not swept: pushed out through the far side
+    assert np.all(np.abs(state.positions[r > 0.11, 2] - 0.04) < 0.005)
+    assert penetration(state.positions, body).count == 0

@@ -23,6 +23,7 @@ from ._collide import (
     collide,
     keep_layers,
     layer_planes,
+    sweep,
     track,
     vertex_active,
 )
@@ -77,6 +78,7 @@ __all__ = [
     "relax",
     "restore_lengths",
     "sqrt3_split",
+    "sweep",
     "track",
     "triangle_frames",
     "untangle",

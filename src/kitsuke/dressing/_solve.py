@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..cloth import BodyCollider, ClothModel, ClothState, collide
+from ..cloth import BodyCollider, ClothModel, ClothState, collide, sweep
 from ..cloth import _kernels as K
 
 #: Weight of the proximal term (each vertex held towards where it is), relative to one triangle edge's weight:
@@ -51,7 +51,10 @@ class GlobalRelax:
     along the body (tangentially; leaving the body stays free) at where it was, with this weight relative to
     one triangle edge, until the solve pulls it off. Without it, gravity slides the whole garment down the
     body (the contact planes are frictionless). cg_iterations : most conjugate-gradient iterations of a contact
-    solve. All faces must be active (it runs after growth).
+    solve. max_move_m : most metres a vertex moves in one step (the step's move is cut back to it), None: no
+    limit (the drag's small steps). sweep_below_y : a move that ends below this height (metres) deep inside a
+    limb, where the collision would push it out through the limb's far side, stops where it entered the limb
+    (`kitsuke.cloth.sweep`); None: no move is swept. All faces must be active (it runs after growth).
     """
 
     def __init__(
@@ -66,6 +69,8 @@ class GlobalRelax:
         gravity_m: float = 0.0,
         stick_weight: float = 0.0,
         cg_iterations: int = CG_ITERATIONS,
+        max_move_m: float | None = None,
+        sweep_below_y: float | None = None,
     ):
         from scipy.sparse import coo_matrix
         from scipy.sparse.linalg import splu
@@ -98,18 +103,20 @@ class GlobalRelax:
         self.cg_iterations = 0
         self.cg_limit = int(cg_iterations)
         self.pinned = pinned.copy()
+        self.max_move_m = max_move_m
+        self.sweep_below_y = sweep_below_y
         nf = model.n_faces
         self._normals = np.zeros((nf, 3))
         self._ref = np.zeros((nf, 3))
         self._flipped = np.zeros(nf, dtype=np.uint8)
         self._goals = np.zeros((nf, 3, 3))
 
-    def step(self, state: ClothState, collider: BodyCollider | None, *, then_collide: bool = True) -> float:
-        """One local/global iteration (in place on `state`); returns the largest vertex move, metres.
+    def step(self, state: ClothState, collider: BodyCollider | None) -> float:
+        """One local/global iteration (in place on `state`); returns the largest vertex move, metres (before the
+        `max_move_m` cut).
 
         collider : the body, for the contact planes inside the solve (when `contact_weight` > 0) and the collision
-        after it; None: neither. then_collide : False leaves the collision after the solve to the caller (the drag
-        clamps each move first)."""
+        after it; None: neither."""
         m = self.model
         pos = state.positions
         K.reference_normals(
@@ -142,9 +149,15 @@ class GlobalRelax:
         else:
             new = self.lu.solve(rhs)
         new[self.pinned] = pos[self.pinned]
-        move = float(np.sqrt(((new - pos) ** 2).sum(axis=1)).max(initial=0.0))
+        length = np.sqrt(((new - pos) ** 2).sum(axis=1))
+        move = float(length.max(initial=0.0))
+        if self.max_move_m is not None and move > self.max_move_m:
+            over = length > self.max_move_m
+            new[over] = pos[over] + (new[over] - pos[over]) * (self.max_move_m / length[over])[:, None]
+        if collider is not None and self.sweep_below_y is not None:
+            sweep(pos, new, ~self.pinned, collider, below_y=self.sweep_below_y)
         pos[:] = new
-        if collider is not None and then_collide:
+        if collider is not None:
             collide(m, state, collider)
         return move
 

@@ -122,12 +122,17 @@ def grow_stage(model: ClothModel, state: ClothState, collider: BodyCollider, con
 
 @dataclass(frozen=True)
 class Closing:
-    """close_stage's config: the settings, and the vertices `held` (V,) bool pulled softly towards `targets`
-    (V, 3) metres (where the strokes laid them), or None."""
+    """close_stage's config: the settings, the vertices `held` (V,) bool pulled softly towards `targets`
+    (V, 3) metres (where the strokes laid them), or None, and the crotch's height `legs_below_y` (metres; None: a
+    body without two legs, or a garment round both, whose close sees them bridged as one). Below it the close's moves are swept (`GlobalRelax`'s `sweep_below_y`): a trouser's
+    back panel laid behind a leg is not pulled through the knee to its front. Above it they are not: laid panels
+    pass through the torso's side and the arm to where their seams close (a side seam at the armpit, a waistband's
+    side at the hip), and are pushed out there."""
 
     settings: CloseSettings
     held: np.ndarray | None = None
     targets: np.ndarray | None = None
+    legs_below_y: float | None = None
 
 
 def close_stage(model: ClothModel, state: ClothState, collider: BodyCollider, config: Closing) -> dict:
@@ -142,6 +147,7 @@ def close_stage(model: ClothModel, state: ClothState, collider: BodyCollider, co
         hold_weight=s.stroke_hold,
         contact_weight=s.contact_weight,
         cg_iterations=s.cg_iterations,
+        sweep_below_y=config.legs_below_y,
     )
     return {"steps": until_still(lambda: solver.step(state, collider), s.iterations, s.tolerance_m)}
 

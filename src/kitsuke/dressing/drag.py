@@ -590,7 +590,7 @@ class DragSession:
         holding = self.state.holding(held)
         if p.release_steps:
             solver = self._global_solver(held)
-            until_still(lambda: self._global_step(solver, holding), p.release_steps, p.release_tolerance_m)
+            until_still(lambda: solver.step(holding, self.collider), p.release_steps, p.release_tolerance_m)
         if p.release_relax_iterations:
             relax(self.model, holding, self.collider, iterations=p.release_relax_iterations)
         untangling = Untangling(p.release_untangle_rounds, iterations=p.release_untangle_iterations)
@@ -673,27 +673,19 @@ class DragSession:
         return polished if kept else None
 
     def _global_solver(self, held: np.ndarray) -> GlobalRelax:
+        """A global relaxation of the session's cloth with `held` pinned, each vertex's move per step cut to
+        `max_relax_move_m`."""
         p = self.params
         # Planes only under the cloth that touches the body (collision leaves it at the offset).
         reach = self.model.params.contact_offset_m + CONTACT_ROUNDOFF_M
         return GlobalRelax(
-            self.model, held, contact_weight=p.contact_weight, contact_reach_m=reach, cg_iterations=p.contact_iterations
+            self.model,
+            held,
+            contact_weight=p.contact_weight,
+            contact_reach_m=reach,
+            cg_iterations=p.contact_iterations,
+            max_move_m=p.max_relax_move_m,
         )
-
-    def _global_step(self, solver: GlobalRelax, holding: ClothState) -> float:
-        """One global relaxation step of the session's cloth (`holding`: its state with the drag's pins), each
-        vertex's move clamped to `max_relax_move_m`, then collision. Returns the largest move, metres (before the
-        clamp)."""
-        pos = holding.positions
-        before = pos.copy()
-        largest = solver.step(holding, self.collider, then_collide=False)
-        step = pos - before
-        length = np.linalg.norm(step, axis=1)
-        over = length > self.params.max_relax_move_m
-        if over.any():
-            pos[over] = before[over] + step[over] * (self.params.max_relax_move_m / length[over])[:, None]
-        collide(self.model, holding, self.collider)
-        return largest
 
     # -- moves ----------------------------------------------------------------------------------------------
     def _grab_or_raise(self) -> Grab:
@@ -815,7 +807,7 @@ class DragSession:
             if p.contact_weight > 0:  # the contact planes where the cloth is now, not where it was
                 collide(m, holding, self.collider)
             for _ in range(p.global_steps):
-                self._global_step(self._solver, holding)
+                self._solver.step(holding, self.collider)
         if p.relax_iterations:
             relax(m, holding, self.collider, iterations=p.relax_iterations)
         self._track_feet()

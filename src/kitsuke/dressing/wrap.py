@@ -369,7 +369,8 @@ def wrap(
     # Step 3, the close: stroke pins released so that collision reaches the stroke triangles too; they are only held
     # softly towards where the strokes put them (`close.stroke_hold`). The mend regrows torn cloth and closes again.
     mended = MendStats()
-    closing = Closing(p.close, held=seed_pins, targets=state.positions.copy())
+    legs = None if gap is None or shaping is not collider else gap.crotch_y  # a skirt's legs are bridged as one
+    closing = Closing(p.close, held=seed_pins, targets=state.positions.copy(), legs_below_y=legs)
     if p.close.iterations:
         run_stage(log, "closing the seams", close_stage, model, state, shaping, closing, pinned=free, timing="close")
         if p.close.tear_strain is not None and p.close.mend_rounds:
