@@ -65,6 +65,19 @@ def test_length_mismatch_is_a_warning_not_an_error(tmp_path):
     assert load_pattern_with_issues(write(tmp_path, d))[1] == []
 
 
+def test_a_sliver_piece_is_a_warning(tmp_path):
+    # GarmentCode's sampler made trouser cuffs 0.25 mm tall and 18.6 cm long; a 1 cm strip is fine.
+    for height, codes in ((0.025, ["sliver"]), (1.0, [])):
+        d = two_squares()
+        d["pieces"].append({"name": "strip", "outline": [[0, 0], [18.6, 0], [18.6, height], [0, height]]})
+        pattern, issues = load_pattern_with_issues(write(tmp_path, d))
+        assert [i.code for i in issues] == codes
+    assert issues == [] and pattern.piece("strip").area == pytest.approx(18.6)
+    d["pieces"][-1]["outline"] = [[0, 0], [18.6, 0], [18.6, 0.025], [0, 0.025]]
+    sliver = validate(load_pattern_with_issues(write(tmp_path, d))[0])[0]
+    assert sliver.severity == "warning" and sliver.piece == "strip" and "0.25 mm wide" in sliver.message
+
+
 def _broken(mutate):
     d = two_squares()
     mutate(d)

@@ -101,7 +101,7 @@ def register(parser: argparse.ArgumentParser) -> None:
         "outline, seams naming unknown pieces or edges, duplicate names, seams that cannot be sewn into one "
         "garment surface, which `kitsuke dress` would refuse) give one line on stderr and exit code 2; "
         "warnings (seam edges differing by more than 1 %; where they differ by more than 3 % and 1 cm, `dress` "
-        "gathers the longer side) are printed and the exit code is 0.",
+        "gathers the longer side; a piece less than 5 mm wide on average) are printed and the exit code is 0.",
         FORMATS + "\nexample:\n  kitsuke pattern validate my_pattern.json\n",
     )
     p.add_argument("pattern", metavar="PATTERN", help="pattern file")

@@ -9,7 +9,8 @@ Errors — a loader refuses the file (InputError naming it) and `validate` lists
   `kitsuke.limits` allows; a piece past the size limits is refused when it is made).
 Warnings — reported, the pattern loads and meshes:
   length-mismatch (a seam's two edges differ by more than 1 % of the longer one: sewing would stretch or ease
-  the cloth; meshing still gives both sides the same number of vertices).
+  the cloth; meshing still gives both sides the same number of vertices), sliver (a piece narrower on average
+  than `SLIVER_CM`: its mesh is a row of needle triangles, and in a wrap its two long sides act as one seam).
 """
 
 from __future__ import annotations
@@ -33,6 +34,9 @@ LENGTH_TOLERANCE = 0.01
 ZERO_AREA_FRACTION = 1e-9
 #: Chord tolerance (cm) of the densified outline used for the self-intersection test.
 INTERSECTION_TOL_CM = 0.02
+#: A piece whose mean width (twice its area over its perimeter: a strip's width) is below this is a sliver, cm.
+#: GarmentCode's sampler makes such cuffs on short trousers (0.25 mm tall, 18.6 cm long), which tore in the wrap.
+SLIVER_CM = 0.5
 
 
 @dataclass(frozen=True)
@@ -107,6 +111,20 @@ def _piece_issues(piece) -> list[Issue]:
                 name,
             )
         )
+    else:
+        perimeter = float(np.linalg.norm(poly - np.roll(poly, -1, axis=0), axis=1).sum())
+        width = 2.0 * area / perimeter
+        if width < SLIVER_CM:
+            out.append(
+                Issue(
+                    "warning",
+                    "sliver",
+                    f"piece {name!r}: {width * 10:.2g} mm wide on average ({area:.2g} cm² over "
+                    f"{perimeter / 2:.3g} cm): a sliver whose mesh is needle triangles; widen it or sew its "
+                    "neighbours to each other",
+                    name,
+                )
+            )
     return out
 
 
