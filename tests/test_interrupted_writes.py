@@ -24,7 +24,9 @@ import os, sys, time
 from pathlib import Path
 original = os.replace
 def slow_replace(src, dst):
-    Path(sys.argv[1]).write_text(str(src))
+    # The marker appears whole (renamed into place): the parent may read it the moment it exists.
+    Path(sys.argv[1] + ".part").write_text(str(src))
+    original(sys.argv[1] + ".part", sys.argv[1])
     time.sleep(60)
     original(src, dst)
 os.replace = slow_replace
