@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from kitsuke.cloth import BodyCollider, ClothModel, ClothParams, ClothState, collide, relax, sweep, track
-from kitsuke.cloth._collide import SWEEP_MIN_M
 from kitsuke.cloth import _collide_kernels as CK
+from kitsuke.cloth._collide import SWEEP_MIN_M
 from kitsuke.cloth._shapes import grid_sheet
 from kitsuke.errors import InputError
 from kitsuke.geometry import TriMesh

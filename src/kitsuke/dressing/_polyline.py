@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry.polygon import polygon_inside
 from ..geometry.surface import Surface, SurfacePoints
 
 
@@ -110,19 +111,6 @@ def stroke_coordinates(points: np.ndarray, stroke: np.ndarray) -> tuple[np.ndarr
     cross = e[seg, 0] * rel[rows, seg, 1] - e[seg, 1] * rel[rows, seg, 0]
     side = np.where(cross >= 0, 1.0, -1.0)
     return s, side * np.sqrt(d2[rows, seg]), seg.astype(np.int64)
-
-
-def polygon_inside(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
-    """(n,) bool: points (n, 2) inside a closed polygon (m, 2), last point not repeated (even-odd rule)."""
-    q = np.asarray(points, dtype=np.float64).reshape(-1, 2)
-    a = np.asarray(polygon, dtype=np.float64)
-    b = np.roll(a, -1, axis=0)
-    x, y = q[:, 0:1], q[:, 1:2]
-    straddle = (a[None, :, 1] > y) != (b[None, :, 1] > y)
-    dy = b[:, 1] - a[:, 1]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        xc = a[None, :, 0] + (y - a[None, :, 1]) * (b[:, 0] - a[:, 0])[None, :] / dy[None, :]
-    return ((straddle & (x < xc)).sum(axis=1) % 2) == 1
 
 
 def polygon_grid(polygon: np.ndarray, n: int) -> np.ndarray:

@@ -124,10 +124,10 @@ def grow_stage(model: ClothModel, state: ClothState, collider: BodyCollider, con
 class Closing:
     """close_stage's config: the settings, the vertices `held` (V,) bool pulled softly towards `targets`
     (V, 3) metres (where the strokes laid them), or None, and the crotch's height `legs_below_y` (metres; None: a
-    body without two legs, or a garment round both, whose close sees them bridged as one). Below it the close's moves are swept (`GlobalRelax`'s `sweep_below_y`): a trouser's
-    back panel laid behind a leg is not pulled through the knee to its front. Above it they are not: laid panels
-    pass through the torso's side and the arm to where their seams close (a side seam at the armpit, a waistband's
-    side at the hip), and are pushed out there."""
+    body without two legs, or a garment round both, whose close sees them bridged as one). Below it the close's
+    moves are swept (`GlobalRelax`'s `sweep_below_y`): a trouser's back panel laid behind a leg is not pulled
+    through the knee to its front. Above it they are not: laid panels pass through the torso's side and the arm to
+    where their seams close (a side seam at the armpit, a waistband's side at the hip), and are pushed out there."""
 
     settings: CloseSettings
     held: np.ndarray | None = None

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry import TriMesh
+from ..geometry.polygon import convex_hull, polygon_inside
 
 #: A cut of the cloth open by at most this much (metres: a dart's open end, a seam whose two sides were meshed
 #: apart) still counts as a loop; the gap adds nothing to the cloth's length round it.
@@ -115,24 +116,10 @@ def _loop(edges: np.ndarray, points: np.ndarray, start: int, gap_m: float) -> li
     return None
 
 
-def _inside(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
-    """(n,) bool: points (n, 2) inside the closed polygon (m, 2) (even-odd rule)."""
-    x, z = points[:, 0][:, None], points[:, 1][:, None]
-    x0, z0 = polygon[:, 0][None], polygon[:, 1][None]
-    x1, z1 = np.roll(polygon[:, 0], -1)[None], np.roll(polygon[:, 1], -1)[None]
-    crosses = (z0 > z) != (z1 > z)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        hit = x < x0 + (z - z0) * (x1 - x0) / (z1 - z0)
-    return (crosses & hit).sum(axis=1) % 2 == 1
-
-
 def _hull_perimeter(points: np.ndarray) -> float:
     """The perimeter of the convex hull of points (n, 2); 0 where they span no area (all on a line)."""
-    from scipy.spatial import ConvexHull, QhullError
-
-    try:
-        hull = ConvexHull(points)
-    except QhullError:
+    hull = convex_hull(points)
+    if hull is None:
         return 0.0
     ring = points[hull.vertices]
     return float(np.linalg.norm(ring - np.roll(ring, 1, axis=0), axis=1).sum())
@@ -178,6 +165,5 @@ def _girth(
     if len(b_idx) == 0:
         return None
     skin = _points(body.vertices, b_edges, b_t).reshape(-1, 3)[:, [0, 2]]
-    inside = skin[_inside(skin, ring)]
-    tape = _hull_perimeter(inside) if len(inside) >= 3 else 0.0
+    tape = _hull_perimeter(skin[polygon_inside(skin, ring)])
     return Girth(y, rest_m, worn_m, tape) if tape > 0.0 else None

@@ -36,6 +36,7 @@ import numpy as np
 
 from ..body.skinning import forward_kinematics, rotation_between
 from ..errors import ComputationError, InputError, require_non_negative
+from ..geometry.polygon import convex_hull
 from ..skeleton import INDEX, descendants
 from .simulate import KimonoSimulator, SimulationSettings
 
@@ -129,18 +130,6 @@ def spread_pose(
     return rotations
 
 
-def _hull(points_xz: np.ndarray):  # noqa: ANN202 - scipy ConvexHull, or None
-    """The convex hull of (n, 2) points seen from above, or None when they span no area."""
-    from scipy.spatial import ConvexHull, QhullError
-
-    if len(points_xz) < 3:
-        return None
-    try:
-        return ConvexHull(points_xz)
-    except QhullError:
-        return None
-
-
 def uncovered(leg_xz: np.ndarray, normals_xz: np.ndarray, cloth_xz: np.ndarray, window_m: float) -> np.ndarray:
     """(n,) bool: the leg points (n, 2) that no cloth covers, seen from above: no cloth point (m, 2) lies ahead of
     the point along its skin's outward normal (n, 2; horizontal part) within `window_m` of that ray (the leg
@@ -157,7 +146,7 @@ def uncovered(leg_xz: np.ndarray, normals_xz: np.ndarray, cloth_xz: np.ndarray, 
 def cross_section_area(cloth: np.ndarray, height_m: float, band_m: float = 0.03) -> float:
     """Area (m²) of the convex hull, seen from above, of the cloth vertices (V, 3) within band_m of height_m."""
     near = cloth[np.abs(cloth[:, 1] - height_m) <= band_m][:, [0, 2]]
-    hull = _hull(near)
+    hull = convex_hull(near)
     if hull is None:
         raise ComputationError("calibration", f"no cloth around the legs at height {height_m:.2f} m")
     return float(hull.volume)  # a 2-D hull's volume is its area
