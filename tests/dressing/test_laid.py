@@ -32,6 +32,7 @@ from kitsuke.pattern import load_pattern
 from ..conftest import DATA
 
 SKIRT = DATA / "pattern" / "corpus" / "gc_s101_0003_specification.json"
+SEWN_TOP = DATA / "pattern" / "corpus" / "gc_s6297_0004_specification.json"
 TORN_SHIRT = DATA / "pattern" / "corpus" / "gc_s2718_0026_specification.json"
 
 
@@ -146,7 +147,8 @@ def test_a_shirt_growth_tears_is_dressed_with_every_piece_laid(run_cli, tmp_path
     `kitsuke dress` says why it dressed twice."""
     body, collider, _, pattern, strokes = _on_mean_all(TORN_SHIRT)
     with pytest.raises(ComputationError, match="wrap: not a garment on the body") as first:
-        wrap(body, pattern, strokes, collider=collider, params=WrapParams().changed({"grow.relay": False}))
+        alone = WrapParams().changed({"grow.relay": False, "close.sew_on_failure": False})
+        wrap(body, pattern, strokes, collider=collider, params=alone)
     write_strokes(strokes, tmp_path / "strokes.json")
     out = tmp_path / "shirt.glb"
     r = run_cli(
@@ -176,3 +178,19 @@ def test_laid_trousers_close_round_the_legs_not_through_them():
     assert garment.laid == [pc.name for pc in pattern.pieces if pc.placement]
     assert on_body_failures(garment, body) == []
     assert garment.report.strain_max < 0.1 and garment.report.penetration_count == 0
+
+
+@pytest.mark.slow
+def test_a_garment_that_fails_grown_and_laid_is_written_with_its_seams_sewn():
+    """A fitted top over a pencil skirt (tests corpus) fails grown (a stroke's cloth 7 cm off) and laid; the last
+    try sews its seams (`kitsuke.cloth.sew`) and the garment is on the body: written, not refused."""
+    body, collider, surface, pattern, strokes = _on_mean_all(SEWN_TOP)
+    unsewn = WrapParams().changed({"close.sew_on_failure": False})
+    with pytest.raises(ComputationError) as first:
+        wrap(body, pattern, strokes, collider=collider, params=unsewn)
+    garment = wrap(body, pattern, strokes, collider=collider)
+    assert garment.sewn and garment.laid == [] and garment.redone_after == first.value.message
+    assert on_body_failures(garment, body, surface=surface) == []
+    assert np.isfinite(garment.positions).all() and garment.report.strain_max < 1.0
+    assert garment.report.penetration_count == 0
+    assert garment.summary()["seams_sewn"] is True

@@ -181,7 +181,10 @@ def run(args: argparse.Namespace) -> int:
     write_garment_outputs(garment, body.mesh, glb, obj, report, png)
     if garment.redone_after:
         laid = "every piece" if set(garment.laid) >= set(pattern.piece_names) else ", ".join(garment.laid)
-        print(f"first try: {garment.redone_after}; dressed again with {laid} laid at the placement", file=sys.stderr)
+        how = " and ".join(
+            ([f"{laid} laid at the placement"] if garment.laid else []) + (["its seams sewn"] if garment.sewn else [])
+        )
+        print(f"first try: {garment.redone_after}; dressed again with {how}", file=sys.stderr)
     misses = target_misses(garment)
     verdict = "all quality targets met" if not misses else "targets missed: " + "; ".join(misses)
     seconds = garment.timings.get("wrap", 0.0) + garment.timings.get("first try", 0.0)

@@ -13,7 +13,8 @@ Typical use::
 small move down, and collision pushes the cloth out of the body. Constants live in `ClothParams`.
 
 `step(model, state, body, dt)` is: XPBD dynamics on the same model and state (with velocities) against a moving
-`MovingBody`; constants in `DynamicsParams` (see `_dynamics.py`).
+`MovingBody`; constants in `DynamicsParams` (see `_dynamics.py`). `sew(model, state, collider)` closes open seams
+with that solver, weightless, a little each frame.
 """
 
 from ._collide import (
@@ -33,6 +34,7 @@ from ._model import ClothModel, ClothParams, ClothState, Contacts, locality_orde
 from ._polish import PolishStats, RefinedPolish, bending_stencil, compile_polish, polish, polish_refined
 from ._precompile import precompile_in_background
 from ._relax import RelaxStats, relax
+from ._sew import SewStats, sew
 from ._shapes import grid_sheet, grid_tube, hugging_tube, triangle_frames
 from ._subdivide import Refinement, colliding_edges, refine, sqrt3_split
 from ._tethers import Tethers
@@ -45,6 +47,7 @@ __all__ = [
     "SkinHold",
     "dynamics_data",
     "step",
+    "sew",
     "ClothModel",
     "ClothParams",
     "ClothState",
@@ -57,6 +60,7 @@ __all__ = [
     "RefinedPolish",
     "Refinement",
     "RelaxStats",
+    "SewStats",
     "Tethers",
     "UntangleStats",
     "collide",

@@ -31,6 +31,7 @@ from ..cloth import (
     dynamics_data,
     relax,
     restore_lengths,
+    sew,
     step,
     untangle,
 )
@@ -137,8 +138,13 @@ class Closing:
 
 def close_stage(model: ClothModel, state: ClothState, collider: BodyCollider, config: Closing) -> dict:
     """The global relaxation without gravity (`_solve.GlobalRelax`, body contacts inside the solve) until still.
-    A fresh solver each time: after a mend regrows cloth, contacts an earlier close had released must hold again."""
+    A fresh solver each time: after a mend regrows cloth, contacts an earlier close had released must hold again.
+    With `sew_frames`, sewing instead (`kitsuke.cloth.sew`), the stroke vertices held where the strokes put them."""
     s = config.settings
+    if s.sew_frames:
+        held = state.pinned if config.held is None else state.pinned | config.held
+        stats = sew(model, state.holding(held), collider, shrink_m=s.sew_shrink_m, max_frames=s.sew_frames)
+        return {"sewn_frames": stats.frames, "diverged": stats.diverged}
     solver = GlobalRelax(
         model,
         state.pinned,

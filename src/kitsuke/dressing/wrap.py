@@ -24,6 +24,9 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
    Jacobi `relax` needs thousands) pulls them shut, the strokes only softly held (`close.stroke_hold`). Where edges
    are still over twice their length after it (growth took the cloth round the wrong side of a limb), that
    cloth is grown again from the closed cloth around it and closed again (`_mend`, `close.tear_strain`).
+   A wrap that still fails after its relay (step 2) is dressed once more with its seams *sewn* instead
+   (`close.sew_on_failure`, `kitsuke.cloth.sew`): the dynamic solver without gravity pulls each stretched edge
+   back a centimetre a frame, so no cloth moves far enough at once to pass through a limb.
 4. **Settle**: relaxation with gravity and collision, the stroke pins released (or, `settle.method="global"`, global
    steps with gravity, the body contacts inside the solve and static friction: `_solve.gravity_settle`).
    Optionally a band of the garment (e.g. where a kimono's obi goes) is held: its vertices over the torso are
@@ -103,7 +106,7 @@ from ._stages import (
 from ._weld import repair_corners, weld
 from .outcome import body_axis, on_body_failures, target_misses, wrong_side_pieces
 from .strokes import Strokes, resolve_strokes
-from .wrap_settings import WrapParams
+from .wrap_settings import SEW_FRAMES, WrapParams
 
 
 @dataclass
@@ -129,8 +132,10 @@ class DressedGarment:
         shape is gathered there, and strain is measured against it.
     laid : pieces laid at their placement instead of grown (`GrowSettings.laid`; by the wrap itself where growth
         took them to the wrong side of the body or failed otherwise, the earlier tries' time in timings["first
-        try"]). redone_after : why the wrap dressed the garment once more (`GrowSettings.relay`): the first
-        try's failure, one line; "" when the first try was kept.
+        try"]). sewn : its close sewed the seams (`CloseSettings.sew_frames`; by the wrap itself when every earlier
+        try failed, `sew_on_failure`). redone_after : why the wrap dressed the garment once more
+        (`GrowSettings.relay`, `CloseSettings.sew_on_failure`): the first try's failure, one line; "" when the
+        first try was kept.
     rings : growth rings. mend : what `_mend.mend_tears` did after the close (rounds, torn edges before and
         after). polished : the polish's result was kept (`PolishSettings.rounds`). timings : seconds per step
         ("mesh", "resolve", "place", "grow", "close", "settle", "finish", "untangle", "polish", "wrap" = all of
@@ -157,6 +162,7 @@ class DressedGarment:
     loose_strokes: list[int] = field(default_factory=list)
     gathers: list[Gather] = field(default_factory=list)
     laid: list[str] = field(default_factory=list)
+    sewn: bool = False
     redone_after: str = ""
     rings: int = 0
     mend: MendStats = field(default_factory=MendStats)
@@ -190,6 +196,7 @@ class DressedGarment:
             "loose_strokes": list(self.loose_strokes),
             "gathered_seams": [dataclasses.asdict(g) | {"ratio": round(g.ratio, 4)} for g in self.gathers],
             "laid_pieces": list(self.laid),
+            "seams_sewn": self.sewn,
             "redone_after": self.redone_after,
             "timings_s": {k: round(v, 4) for k, v in self.timings.items()},
             "strokes": [
@@ -482,6 +489,7 @@ def wrap(
         loose_strokes=[tr.id for tr, far in zip(placement.tracks, loose, strict=True) if far],
         gathers=gathers,
         laid=[pm.piece_names[k] for k in laid],
+        sewn=bool(p.close.sew_frames),
         rings=grown["rings"],
         polished=done.polished,
         mend=mended,
@@ -507,29 +515,38 @@ def wrap(
             more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
             failure = ComputationError("wrap", f"not a garment on the body: {bad[0]}{more}", result=result)
             wrong = [pm.piece_names[k] for k, _ in wrong_side_pieces(result, mesh) if k not in laid]
-            if not p.grow.relay or (not wrong and (every or not pm.placed.any())):
-                raise failure
-            # Pieces growth took to the wrong side are laid at their placement; a failure without such a piece
-            # (cloth torn round a limb, a piece off the body) is dressed once more with every placed piece laid.
-            again_laid = tuple(p.grow.laid) + tuple(wrong) if wrong else ("*",)
-            say(f"laying {', '.join(wrong) or 'every piece'} at the placement")
-            again = p.changed({"grow.laid": again_laid})
-            try:
-                redone = wrap(
-                    body,
-                    garment,
-                    strokes,
-                    pattern=pattern,
-                    params=again,
-                    collider=collider,
-                    report=report,
-                    progress=progress,
-                )
-            except ComputationError:
-                raise failure from None
-            redone.timings["first try"] = timings["wrap"] + redone.timings.get("first try", 0.0)  # all earlier tries
-            redone.redone_after = failure.message  # the first try's (an inner relay set its own)
-            return redone
+            tries = []
+            if p.grow.relay and (wrong or not (every or not pm.placed.any())):
+                # Pieces growth took to the wrong side are laid at their placement; a failure without such a piece
+                # (cloth torn round a limb, a piece off the body) is dressed once more with every placed piece
+                # laid. That try sews nothing itself: the sewn try below comes after it.
+                again_laid = tuple(p.grow.laid) + tuple(wrong) if wrong else ("*",)
+                relay = p.changed({"grow.laid": again_laid, "close.sew_on_failure": False})
+                tries.append((f"laying {', '.join(wrong) or 'every piece'} at the placement", relay))
+            if p.close.sew_on_failure and not p.close.sew_frames:
+                # The last resort: the same garment with its seams sewn (and, failing that, its own relay, sewn).
+                sewn = p.changed({"close.sew_frames": SEW_FRAMES, "close.sew_on_failure": False})
+                tries.append(("sewing the seams", sewn))
+            for what, again in tries:
+                say(what)
+                try:
+                    redone = wrap(
+                        body,
+                        garment,
+                        strokes,
+                        pattern=pattern,
+                        params=again,
+                        collider=collider,
+                        report=report,
+                        progress=progress,
+                    )
+                except ComputationError as e:
+                    timings["wrap"] += e.result.timings.get("wrap", 0.0) if e.result is not None else 0.0
+                    continue
+                redone.timings["first try"] = timings["wrap"] + redone.timings.get("first try", 0.0)  # earlier tries
+                redone.redone_after = failure.message  # the first try's (an inner relay set its own)
+                return redone
+            raise failure
     return result
 
 

@@ -119,6 +119,10 @@ class GrowSettings:
             raise InputError("GrowSettings.laid must be piece names")
 
 
+#: Frames of sewing when a failed wrap is dressed once more with its seams sewn (`CloseSettings.sew_on_failure`).
+SEW_FRAMES = 90
+
+
 @dataclass(frozen=True)
 class CloseSettings:
     """Step 3, closing the seams: a global relaxation without gravity (`_solve.GlobalRelax`), then mending tears.
@@ -136,6 +140,15 @@ class CloseSettings:
         again from the closed cloth around it and closed again (`_mend`: growth took it round the wrong side of a
         limb); None: no mending.
     mend_rounds : most mending rounds.
+    sew_frames : 0: the close is the global relaxation. Otherwise it sews instead (`kitsuke.cloth.sew`: the dynamic
+        solver without gravity, each stretched edge's rest length shrinking `sew_shrink_m` a frame from its length
+        to the pattern's, for at most this many frames): slower, and on the corpus its garments are more strained
+        where the relaxation closes them well (simple waistbands 2-4 -> 11-19 % max strain), but it never moves
+        cloth far enough in one step to pass through a limb.
+    sew_shrink_m : see sew_frames, metres per frame.
+    sew_on_failure : a wrap that still fails after its relay (torn round a limb, off the body) is dressed once more
+        with its seams sewn (`sew_frames` SEW_FRAMES): on 20 corpus designs, 10 failures written instead (out of
+        target: 17-78 % max strain).
     """
 
     iterations: int = 15
@@ -145,10 +158,15 @@ class CloseSettings:
     contact_weight: float = 20.0
     tear_strain: float | None = 1.0
     mend_rounds: int = 3
+    sew_frames: int = 0
+    sew_shrink_m: float = 0.01
+    sew_on_failure: bool = True
 
     def __post_init__(self) -> None:
         _at_least(self, 1, "cg_iterations")
-        _at_least(self, 0, "iterations", "mend_rounds")
+        _at_least(self, 0, "iterations", "mend_rounds", "sew_frames")
+        if not self.sew_shrink_m > 0:
+            raise InputError("CloseSettings.sew_shrink_m must be > 0 metres per frame")
         if not (self.tolerance_m >= 0 and self.stroke_hold >= 0 and self.contact_weight >= 0):
             raise InputError("CloseSettings.tolerance_m, .stroke_hold and .contact_weight must be >= 0")
         if self.tear_strain is not None and not self.tear_strain > 0:
