@@ -109,6 +109,7 @@ def dress_one(path: Path, body, collider, surface, rng, perturb: bool, drag: boo
         row.update(status="failed", reason=str(e)[:160], seconds=time.perf_counter() - t0)
         return row
     row["seconds"] = time.perf_counter() - t0
+    row["dressed"] = dressed_how(garment.laid, garment.sewn)
     r = garment.report
     row.update(
         strain_mean=r.strain_mean,
@@ -146,6 +147,12 @@ def insane(positions, strain_max: float, surface) -> list[str]:
 
 #: kitsuke.batch statuses -> this benchmark's classes.
 BATCH_STATUS = {"ok": "ok", "out_of_target": "out of target", "refused": "refused", "failed": "failed"}
+
+
+def dressed_how(laid: list[str], sewn: bool) -> str:
+    """How a written garment was dressed: "grown" (the first try), "laid" (some pieces laid at the placement) and/or
+    "sewn" (its seams sewn: every earlier try failed)."""
+    return "+".join(["laid"] * bool(laid) + ["sewn"] * bool(sewn)) or "grown"
 
 
 def batch_jobs(paths: list[Path], perturb: bool) -> list:
@@ -196,6 +203,8 @@ def dress_batch(paths: list[Path], surface, perturb: bool, runner: str, workers:
                     stroke_mm=m["stroke_mm"],
                 )
                 row["cut_smaller"] = CUT_SMALLER.search(row["reason"]) is not None
+                report = json.loads((out / job.id / "report.json").read_text())
+                row["dressed"] = dressed_how(report["laid_pieces"], report["seams_sewn"])
                 bad = insane(read_garment_obj(out / job.id / "garment.obj").positions, row["strain_max"], surface)
                 if bad:
                     row.update(status="garbage", reason="; ".join(bad))
@@ -294,7 +303,8 @@ def main() -> None:
                 row["seed"] = seed
                 rows.append(row)
                 print(
-                    f"{row['design']:16s} {row['kind'][:28]:28s} {row['status']:13s} {row.get('seconds', 0):6.1f} s  "
+                    f"{row['design']:16s} {row['kind'][:28]:28s} {row['status']:13s} {row.get('dressed', ''):9s}"
+                    f" {row.get('seconds', 0):6.1f} s  "
                     f"mean {100 * row.get('strain_mean', np.nan):5.2f} %  "
                     f"max {100 * row.get('strain_max', np.nan):6.1f} %"
                     f"  deep {row.get('deepest_mm', np.nan):5.1f} mm  stroke {row.get('stroke_mm', np.nan):5.1f} mm"
@@ -322,6 +332,10 @@ def main() -> None:
         f"  out of target where the worst strain lies on cloth cut 2 % or more smaller than the body round it: "
         f"{sum(r.get('cut_smaller', False) for r in out)} of {len(out)}"
     )
+    written = [r for r in rows if "dressed" in r]
+    if written:
+        how = {h: sum(r["dressed"] == h for r in written) for h in sorted({r["dressed"] for r in written})}
+        print("  written garments dressed: " + ", ".join(f"{h} {v}" for h, v in how.items()))
     if times:
         print(f"  time: median {np.median(times):.1f} s, worst {max(times):.1f} s")
     if args.drag:
