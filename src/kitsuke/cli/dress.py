@@ -27,6 +27,8 @@ The command exits 0 when the garment is written, whether or not every quality ta
 misses are said on stderr and in the report ("targets_missed"). When the result is not a garment on the body
 (non-finite, a piece off the body, torn cloth, a stroke far from where it was drawn) it exits 1 with one line
 naming the stage and the piece or stroke, and writes nothing (--keep-failed writes it as OUT.failed.glb ...).
+Before giving up it dresses the garment again: with its pieces laid where the pattern's placement puts them, then
+with its seams sewn a little at a time (slower, never through a limb); stderr says which try was kept.
 
 Re-wrap: give --garment (a dressed OBJ written by --obj) instead of --pattern, and a strokes file with
 "target": "garment" (its pattern strokes on the garment's pieces, cm; its 3D strokes drawn on the garment where
