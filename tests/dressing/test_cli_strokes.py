@@ -79,3 +79,20 @@ def test_suggest_refuses_a_bad_min_area_naming_the_flag(run_cli, tmp_path, share
     out = tmp_path / "s.json"
     r = run_cli("strokes", "suggest", "--body", MEAN_ALL, "--pattern", SHIRT, "-o", out, "--min-area", share)
     assert r.code == 2 and "--min-area" in r.err and len(r.err.strip().splitlines()) == 1 and not out.exists()
+
+
+@pytest.mark.slow
+def test_suggest_raises_a_skirt_laid_at_the_hips_and_says_so(run_cli, tmp_path):
+    skirt = DATA / "pattern" / "corpus" / "gc_s6297_0001_specification.json"
+    out = tmp_path / "skirt.json"
+    r = run_cli("strokes", "suggest", "--body", MEAN_ALL, "--pattern", skirt, "-o", out)
+    assert r.code == 0, r.err
+    raised = read_strokes(out).meta["raised_m"]
+    assert raised >= 0.08 and f"raised {100 * raised:.0f} cm" in r.err
+    kept = tmp_path / "kept.json"
+    r = run_cli("strokes", "suggest", "--body", MEAN_ALL, "--pattern", skirt, "-o", kept, "--no-raise")
+    assert r.code == 0 and "raised" not in r.err
+    # Left where it rests, its strokes lie lower on the body.
+    low = min(p.body.points[:, 1].max() for p in read_strokes(kept).pairs)
+    high = min(p.body.points[:, 1].max() for p in read_strokes(out).pairs)
+    assert high >= low + 0.05

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 
 from ._common import add_body_options, body_from_args, checked_output
@@ -12,7 +13,10 @@ The pattern must say where its pieces go: a GarmentCode specification places eve
 kimono from `kitsuke pattern kimono` hangs its pieces as on a kimono stand. Each piece large enough to matter gets
 one stroke along its long axis through its middle, inside the piece; its body stroke is where the placed piece
 meets the body along its normal, as long as the pattern stroke. Smaller pieces (cuffs, waistbands, collars) get
-none: in the wrap they follow their seams. Pattern points are written in the pattern file's own coordinates (for
+none: in the wrap they follow their seams. The garment is then dressed once, quickly, and each body stroke moved
+to where its cloth came to rest; a garment resting tighter than the body round it (a skirt cut for the waist that
+the placement lays at the hips) is raised, strokes and all, until it fits (--no-raise: left where it rests).
+Pattern points are written in the pattern file's own coordinates (for
 GarmentCode, its panel coordinates), as a user would draw them. Open the result in the app or any editor, change
 what you like, then dress.
 
@@ -51,6 +55,11 @@ def register(parser: argparse.ArgumentParser) -> None:
         metavar="SHARE",
         help="a piece gets a stroke when its area is at least this share of the largest piece's (default 0.15)",
     )
+    p.add_argument(
+        "--no-raise",
+        action="store_true",
+        help="leave a garment where it rests even when it is tighter there than the body round it",
+    )
     add_body_options(p)
     p.set_defaults(run=run_suggest)
 
@@ -77,7 +86,9 @@ def run_suggest(args: argparse.Namespace) -> int:
     if args.min_area is not None and not 0.0 <= args.min_area <= 1.0:
         raise InputError(f"--min-area must be a share between 0 and 1, got {args.min_area}")
     pattern = load_pattern(args.pattern)
-    params = SuggestParams() if args.min_area is None else SuggestParams(min_area_share=args.min_area)
+    params = SuggestParams(fit=not args.no_raise)
+    if args.min_area is not None:
+        params = dataclasses.replace(params, min_area_share=args.min_area)
     body = body_from_args(args)
     try:
         strokes = suggest_strokes(body, pattern, params=params)
@@ -86,7 +97,9 @@ def run_suggest(args: argparse.Namespace) -> int:
     strokes.meta["body"] = args.body
     write_strokes(strokes, out)
     pieces = ", ".join(p.pattern.piece for p in strokes.pairs)
-    print(f"wrote {out}: {len(strokes)} stroke pair(s) on {pieces}", file=sys.stderr)
+    raised = strokes.meta.get("raised_m", 0.0)
+    fit = f"; raised {100 * raised:.0f} cm from where it rested, to fit the body" if raised else ""
+    print(f"wrote {out}: {len(strokes)} stroke pair(s) on {pieces}{fit}", file=sys.stderr)
     return 0
 
 

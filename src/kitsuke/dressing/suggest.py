@@ -11,7 +11,9 @@ that line, within `reach_m`), which keeps a sleeve's stroke on its arm where a n
 the torso. The longest run of points that the body continues without a jump becomes the body stroke, and the
 longer of the two strokes is trimmed about its middle so that both have the same length. Last, the garment is
 wrapped once on these strokes and each body stroke moves to where its pattern stroke came to rest
-(`settled_strokes`): a placement is a layout, not where the sewn garment hangs.
+(`settled_strokes`): a placement is a layout, not where the sewn garment hangs. A garment that rests there tighter
+than the body round it (GarmentCode lays a skirt cut for the waist at the hips) is raised until it fits, its
+strokes with it (`_fit_height`).
 
 Two fallbacks, both after the carry along the normal (so a sleeve that reaches its arm keeps its stroke there):
 
@@ -33,11 +35,14 @@ from ..geometry.mesh import TriMesh
 from ..geometry.surface import Surface
 from ..pattern import Pattern, Piece
 from ._far_pieces import drawn_in_placements
+from ._fit_height import fitting_lift
 from ._polyline import arc_length, interpolate_polyline, polygon_distance, polygon_grid, polygon_inside
 from .strokes import BodyStroke, PatternStroke, StrokePair, Strokes
 
 #: Grid cells across a piece's bounding box when its area moments are sampled.
 MOMENT_GRID = 48
+#: How many times a garment resting tighter than the body is raised and settled again (`settled_strokes`).
+FIT_ROUNDS = 2
 
 
 @dataclass(frozen=True)
@@ -58,6 +63,8 @@ class SuggestParams:
         drawn in touches the hips and hangs free below them; a hand draws a little past the widest point).
     settle : move each body stroke to where its pattern stroke rests once the garment, wrapped on the strokes
         from the placement, has settled (`settled_strokes`), so the strokes ask for what the garment can give.
+    fit : with `settle`, raise a garment that rests tighter than the body round it until it fits
+        (`_fit_height.fitting_lift`), its body strokes with it.
     """
 
     min_area_share: float = 0.15
@@ -70,6 +77,7 @@ class SuggestParams:
     drawn_in_reach_m: float = 0.06
     drawn_in_below_m: float = 0.10
     settle: bool = True
+    fit: bool = True
 
     def __post_init__(self) -> None:
         if not (
@@ -298,29 +306,41 @@ def suggest_strokes(
         )
     meta = {"made_by": "kitsuke strokes suggest", "pattern": pattern.name, "settled": False}
     strokes = Strokes(pairs, "body", meta)
-    return settled_strokes(body, pattern, strokes, surf) if p.settle else strokes
+    return settled_strokes(body, pattern, strokes, surf, fit=p.fit) if p.settle else strokes
 
 
-def settled_strokes(body, pattern: Pattern, strokes: Strokes, surface: Surface) -> Strokes:
+def settled_strokes(body, pattern: Pattern, strokes: Strokes, surface: Surface, *, fit: bool = True) -> Strokes:
     """`strokes` with each body stroke moved to where its pattern stroke lies once the garment has settled on
     them (a quick wrap: no polish, strokes not held after the settle); `strokes` as they are when that wrap
     fails. A placement is a layout around the body, not where the sewn garment rests: GarmentCode lays a crop top's
     panels flat in front of and behind the body, and sewn over the shoulders it rides 7-10 cm higher, where
-    strokes drawn on the layout cannot hold it without tearing (190 % max strain held there)."""
+    strokes drawn on the layout cannot hold it without tearing (190 % max strain held there).
+    fit : a garment that rests tighter than the body round it has its strokes raised by `fitting_lift` and is
+    settled again, up to `FIT_ROUNDS` times (raised once, a skirt whose loops pull in oblique folds rests lower
+    than the lift measured: 1.00 m instead of 1.07 m)."""
     from ..errors import ComputationError
     from .wrap import WrapParams, wrap
 
     quick = WrapParams().changed({"polish.rounds": 0, "tethers.reach_m": None})
-    try:
-        g = wrap(body, pattern, strokes, params=quick, report=False, check=False)
-    except (ComputationError, InputError):
-        return strokes
-    if not np.isfinite(g.positions).all():
-        return strokes
-    pairs = []
-    for pair, track in zip(strokes.pairs, g.tracks, strict=True):
-        on = surface.closest(track.points(g.positions, g.faces)).points
-        if track.reversed:
-            on = on[::-1]
-        pairs.append(StrokePair(pair.id, pair.pattern, BodyStroke(points=np.round(on, 4))))
-    return Strokes(pairs, "body", {**strokes.meta, "settled": True})
+    mesh = body if isinstance(body, TriMesh) else body.mesh
+    raised, out = 0.0, strokes
+    for round_ in range(1 + (FIT_ROUNDS if fit else 0)):
+        try:
+            g = wrap(body, pattern, out, params=quick, report=False, check=False)
+        except (ComputationError, InputError):
+            break
+        if not np.isfinite(g.positions).all():
+            break
+        lift = fitting_lift(g.positions, g.faces, g.model.rest_corners, mesh, surface) if round_ < FIT_ROUNDS else 0.0
+        lift *= fit
+        pairs = []
+        for pair, track in zip(out.pairs, g.tracks, strict=True):
+            on = surface.closest(track.points(g.positions, g.faces) + [0.0, lift, 0.0]).points
+            if track.reversed:
+                on = on[::-1]
+            pairs.append(StrokePair(pair.id, pair.pattern, BodyStroke(points=np.round(on, 4))))
+        raised += lift
+        out = Strokes(pairs, "body", {**strokes.meta, "settled": True, "raised_m": round(raised, 3)})
+        if not lift:
+            break
+    return out

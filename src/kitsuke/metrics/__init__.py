@@ -6,7 +6,7 @@ measure against the targets of issue 3.
     report.ok, report.failures(), report.to_dict()
 """
 
-from ._girth import Girth, garment_girth
+from ._girth import Girth, WornLoop, body_section, garment_girth, tape_inside, worn_loop
 from ._layers import layer_crossing_mm, wrong_side_mm
 from ._measures import (
     COLLAPSE_RATIO,
@@ -30,6 +30,8 @@ __all__ = [
     "QualityTargets",
     "SeamGap",
     "Strain",
+    "WornLoop",
+    "body_section",
     "garment_girth",
     "inverted_triangles",
     "layer_crossing_mm",
@@ -38,6 +40,8 @@ __all__ = [
     "quality_report",
     "seam_gap",
     "strain",
+    "tape_inside",
     "vertex_strain",
+    "worn_loop",
     "wrong_side_mm",
 ]
