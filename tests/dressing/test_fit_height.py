@@ -147,3 +147,7 @@ def test_a_pencil_skirt_laid_at_the_hips_is_suggested_at_its_waist_and_dresses_w
     assert "raised_m" not in low.meta or low.meta["raised_m"] == 0.0
     hips = wrap(body, pattern, low, collider=collider)
     assert hips.report.strain_max > 0.2
+    # ... and the report says where it would fit.
+    assert hips.fits_higher_m >= 0.05 and hips.summary()["fits_higher_m"] == round(hips.fits_higher_m, 3)
+    strain_line = [m for m in target_misses(hips, QualityTargets.robust()) if m.startswith("max edge strain")]
+    assert f"it would fit {100 * hips.fits_higher_m:.0f} cm higher" in strain_line[0]

@@ -37,6 +37,7 @@ class FitSettings:
         metres of skin whose outward normal points up by more than `shoulder_normal` (the shoulders' tops)
         hangs from the shoulders and is not raised (GarmentCode's shirt on mean_all: 6.5 % of its vertices; shirts
         over skirts that slid 7-15 cm down: 0-0.1 %, and two that tore at the sleeve once raised: 1.6-2.8 %).
+        Only skin in the upper `shoulder_height` share of the body counts (a long skirt lies on the feet's tops).
     """
 
     tolerance: float = 0.03
@@ -47,6 +48,7 @@ class FitSettings:
     shoulder_normal: float = 0.6
     rest_m: float = 0.015
     rest_share: float = 0.01
+    shoulder_height: float = 0.5
 
     def __post_init__(self) -> None:
         if not (
@@ -58,6 +60,7 @@ class FitSettings:
             and -1 <= self.shoulder_normal <= 1
             and self.rest_m > 0
             and 0 <= self.rest_share <= 1
+            and 0 <= self.shoulder_height <= 1
         ):
             raise InputError(
                 "FitSettings: tolerance in [0, 1), step_m > 0, the others >= 0 (shoulder_normal in [-1, 1])"
@@ -65,9 +68,11 @@ class FitSettings:
 
 
 def hangs_from_shoulders(positions: np.ndarray, surface: Surface, settings: FitSettings) -> bool:
-    """Does the cloth (V, 3) metres rest on skin facing up (`FitSettings.shoulder_normal`)?"""
-    face, _, distance = surface.nearest(positions)
-    near = distance <= settings.rest_m
+    """Does the cloth (V, 3) metres rest on skin facing up (`FitSettings.shoulder_normal`) in the upper part of the
+    body (`shoulder_height`)?"""
+    face, point, distance = surface.nearest(positions)
+    low, high = surface.vertices[:, 1].min(), surface.vertices[:, 1].max()
+    near = (distance <= settings.rest_m) & (point[:, 1] >= high - settings.shoulder_height * (high - low))
     up = surface.normals_at(face[near])[:, 1] > settings.shoulder_normal
     return bool(up.sum() >= settings.rest_share * len(positions))
 

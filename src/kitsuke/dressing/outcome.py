@@ -182,10 +182,12 @@ def target_misses(garment, targets: QualityTargets | None = None) -> list[str]:
     t = targets or QualityTargets()
     out = [] if garment.report is None else garment.report.failures(t)
     girth = getattr(garment, "girth", None)  # a DressedGarment's; a garment read from a file has none
-    if girth is not None and girth.short >= SHORT_SAID:  # the pattern must stretch there, however it is dressed
+    if girth is not None and girth.short >= SHORT_SAID:  # the pattern must stretch there, as dressed
+        higher = getattr(garment, "fits_higher_m", 0.0)
+        where = f"; it would fit {100 * higher:.0f} cm higher, its strokes drawn there" if higher else ""
         out = [
             f"{line}; the cloth round the body there is {100 * girth.rest_m:.1f} cm long, the body "
-            f"{100 * girth.body_m:.1f} cm: cut {100 * girth.short:.0f} % smaller than the body"
+            f"{100 * girth.body_m:.1f} cm: cut {100 * girth.short:.0f} % smaller than the body{where}"
             if line.startswith("max edge strain")
             else line
             for line in out

@@ -41,7 +41,7 @@ from .strokes import BodyStroke, PatternStroke, StrokePair, Strokes
 
 #: Grid cells across a piece's bounding box when its area moments are sampled.
 MOMENT_GRID = 48
-#: How many times a garment resting tighter than the body is raised and settled again (`settled_strokes`).
+#: Most settles of a garment resting tighter than the body, each followed by a raise (`settled_strokes`).
 FIT_ROUNDS = 2
 
 
@@ -315,24 +315,24 @@ def settled_strokes(body, pattern: Pattern, strokes: Strokes, surface: Surface, 
     fails. A placement is a layout around the body, not where the sewn garment rests: GarmentCode lays a crop top's
     panels flat in front of and behind the body, and sewn over the shoulders it rides 7-10 cm higher, where
     strokes drawn on the layout cannot hold it without tearing (190 % max strain held there).
-    fit : a garment that rests tighter than the body round it has its strokes raised by `fitting_lift` and is
-    settled again, up to `FIT_ROUNDS` times (raised once, a skirt whose loops pull in oblique folds rests lower
-    than the lift measured: 1.00 m instead of 1.07 m)."""
+    fit : a garment that rests tighter than the body round it has its strokes raised by `fitting_lift` from where
+    its cloth rests; it is then settled again on them, and raised again from there if it still needs it, for at
+    most `FIT_ROUNDS` settles. The last raise is kept as it is: a settle does not hold the strokes, and a skirt
+    slides back down part of the way in it (a godet skirt raised 4 cm rose 1 cm)."""
     from ..errors import ComputationError
     from .wrap import WrapParams, wrap
 
     quick = WrapParams().changed({"polish.rounds": 0, "tethers.reach_m": None})
     mesh = body if isinstance(body, TriMesh) else body.mesh
     raised, out = 0.0, strokes
-    for round_ in range(1 + (FIT_ROUNDS if fit else 0)):
+    for _ in range(FIT_ROUNDS if fit else 1):
         try:
             g = wrap(body, pattern, out, params=quick, report=False, check=False)
         except (ComputationError, InputError):
             break
         if not np.isfinite(g.positions).all():
             break
-        lift = fitting_lift(g.positions, g.faces, g.model.rest_corners, mesh, surface) if round_ < FIT_ROUNDS else 0.0
-        lift *= fit
+        lift = fitting_lift(g.positions, g.faces, g.model.rest_corners, mesh, surface) if fit else 0.0
         pairs = []
         for pair, track in zip(out.pairs, g.tracks, strict=True):
             on = surface.closest(track.points(g.positions, g.faces) + [0.0, lift, 0.0]).points

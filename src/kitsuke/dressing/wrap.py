@@ -80,6 +80,7 @@ from ..geometry import TriMesh
 from ..metrics import Girth, QualityReport, QualityTargets, garment_girth, quality_report, strain
 from ..pattern import Pattern, PatternMesh, face_layers, mesh_pattern
 from ._bridge import bridged, spans_legs
+from ._fit_height import fitting_lift
 from ._gather import Gather, gathered_rest
 from ._laid import lay_at_placement
 from ._mend import MendStats, mend_tears
@@ -104,7 +105,7 @@ from ._stages import (
     untangle_stage,
 )
 from ._weld import repair_corners, weld
-from .outcome import body_axis, on_body_failures, target_misses, wrong_side_pieces
+from .outcome import SHORT_SAID, body_axis, on_body_failures, target_misses, wrong_side_pieces
 from .strokes import Strokes, resolve_strokes
 from .wrap_settings import SEW_FRAMES, WrapParams
 
@@ -142,7 +143,9 @@ class DressedGarment:
         them, "report").
     report : the SPEC §6 quality report against the body. girth : the horizontal loop of cloth through its worst
         strained edge against the body's girth there (`kitsuke.metrics.garment_girth`: a garment cut smaller than
-        the body must stretch), or None where that cut does not go round the body.
+        the body must stretch), or None where that cut does not go round the body. fits_higher_m : where that loop
+        is cut smaller than the body, how far up the garment would fit (`_fit_height.fitting_lift`; 0: nowhere
+        within reach, or it hangs from the shoulders): its strokes were drawn too low.
     """
 
     name: str
@@ -170,6 +173,7 @@ class DressedGarment:
     timings: dict[str, float] = field(default_factory=dict)
     report: QualityReport | None = None
     girth: Girth | None = None
+    fits_higher_m: float = 0.0
 
     @property
     def n_vertices(self) -> int:
@@ -216,6 +220,7 @@ class DressedGarment:
             ],
             "quality": None if self.report is None else self.report.to_dict(),
             "girth_at_worst_strain": None if self.girth is None else self.girth.to_dict(),
+            "fits_higher_m": round(self.fits_higher_m, 3),
             "targets_missed": None if self.report is None else target_misses(self),
         }
 
@@ -508,6 +513,9 @@ def wrap(
             worst = out_model.edges[result.report.strain_worst_edges[0]]
             at = state.positions[worst].mean(axis=0)
             result.girth = garment_girth(state.positions, out_model.faces, out_model.rest_corners, mesh, at)
+            if result.girth is not None and result.girth.short >= SHORT_SAID:
+                at_rest = (state.positions, out_model.faces, out_model.rest_corners)
+                result.fits_higher_m = fitting_lift(*at_rest, mesh, surface)
         timings["report"] = time.perf_counter() - t6
     if check:
         bad = on_body_failures(result, body, surface=surface)
