@@ -16,9 +16,8 @@ meets the body along its normal, as long as the pattern stroke. Smaller pieces (
 none: in the wrap they follow their seams. The garment is then dressed once, quickly, and each body stroke moved
 to where its cloth came to rest; a garment resting tighter than the body round it (a skirt cut for the waist that
 the placement lays at the hips) is raised, strokes and all, until it fits (--no-raise: left where it rests).
-Pattern points are written in the pattern file's own coordinates (for
-GarmentCode, its panel coordinates), as a user would draw them. Open the result in the app or any editor, change
-what you like, then dress.
+Pattern points are written in the pattern file's own coordinates (for GarmentCode, its panel coordinates), as a
+user would draw them. Open the result in the app or any editor, change what you like, then dress.
 
 examples:
   kitsuke strokes suggest --body mean_all.obj --pattern shirt_mean_specification.json -o shirt_strokes.json
