@@ -5,7 +5,9 @@ arm is worn when every piece is laid."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import re
 import zlib
 from pathlib import Path
 from types import SimpleNamespace
@@ -26,7 +28,7 @@ from kitsuke.dressing import (
 )
 from kitsuke.dressing._laid import lay_at_placement
 from kitsuke.dressing._place import Placement
-from kitsuke.dressing.outcome import mean_turn, wrong_side_pieces
+from kitsuke.dressing.outcome import mean_turn, sunk_pieces, wrong_side_pieces
 from kitsuke.errors import ComputationError, InputError
 from kitsuke.pattern import load_pattern
 
@@ -118,6 +120,16 @@ def test_the_unstroked_pieces_laid_at_their_placement_are_worn_where_it_puts_the
     k = g.piece_names.index("skirt_front")
     a, b = g.piece_faces[k]
     assert g.positions[np.unique(g.faces[a:b])][:, 2].mean() > 0.05  # in front of the body (it faces +Z)
+    # The same garment with its front waistband slid 45 cm down the legs is not a garment on the body; 5 cm down
+    # it still is (`SUNK_M`: 25 cm).
+    assert sunk_pieces(g) == []
+    band = np.unique(g.faces[slice(*g.piece_faces[g.piece_names.index("wb_front")])])
+    for drop, said in ((0.45, True), (0.05, False)):
+        slid = dataclasses.replace(g, positions=g.positions.copy())
+        slid.positions[band, 1] -= drop
+        lines = sunk_pieces(slid)
+        assert (len(lines) == 1 and re.match(r"piece wb_front ended \d+ cm below where", lines[0]) is not None) is said
+        assert any("wb_front ended" in line for line in on_body_failures(slid, body, surface=surface)) is said
 
 
 def test_a_laid_piece_the_pattern_does_not_have_is_refused(skirt_on_back_stroke):

@@ -43,6 +43,10 @@ SIDE_M = 0.05
 WRONG_SIDE_DEG = 120.0
 #: A turn of the stroked pieces under this many degrees is not mentioned in `wrong_side`'s message.
 SAME_TURN_DEG = 20.0
+#: A piece without a stroke whose top ended more than this far (metres) below where its placement puts it, moved
+#: up or down as the stroked pieces were, has fallen off where it is worn (a skirt's waistband found round the
+#: knees).
+SUNK_M = 0.25
 
 
 def _side(v: np.ndarray) -> str:
@@ -112,6 +116,32 @@ def wrong_side_pieces(garment, mesh: TriMesh) -> list[tuple[int, str]]:
     return out
 
 
+def sunk_pieces(garment) -> list[str]:
+    """Pieces without a stroke whose top ended more than `SUNK_M` below their placement's top, moved up or down
+    by the stroked pieces' mean height change (their tops', as placed and as worn), one line each. A piece hangs
+    from its top: a flared skirt's panel laid flat and then draped keeps its top at the waist, a waistband that
+    slid down the legs does not. Only falls are judged: a piece placed under the floor ends higher."""
+    pm = getattr(garment, "pattern_mesh", None)
+    vertex_of = getattr(garment, "pattern_vertex", None)
+    if pm is None or vertex_of is None or len(vertex_of) != pm.n_vertices:
+        return []
+    tops = {}  # piece -> (placed top, worn top), metres
+    for k in range(len(pm.piece_names)):
+        if pm.placed[k]:
+            a, b = pm.piece_vertices[k]
+            tops[k] = (float(pm.positions_m[a:b, 1].max()), float(garment.positions[vertex_of[a:b], 1].max()))
+    stroked = _stroked_pieces(garment) & set(tops)
+    if not stroked:
+        return []
+    moved = float(np.mean([tops[k][1] - tops[k][0] for k in stroked]))
+    return [
+        f"piece {pm.piece_names[k]} ended {100 * (placed + moved - worn):.0f} cm below where its placement puts "
+        f"it (its top at {worn:.2f} m)"
+        for k, (placed, worn) in tops.items()
+        if k not in stroked and worn < placed + moved - SUNK_M
+    ]
+
+
 def wrong_side(garment, mesh: TriMesh) -> list[str]:
     """`wrong_side_pieces`' lines."""
     return [line for _, line in wrong_side_pieces(garment, mesh)]
@@ -165,6 +195,7 @@ def on_body_failures(garment, body, *, surface: Surface | None = None) -> list[s
             f" at ({', '.join(f'{c:.2f}' for c in pos[e[worst, 0]])}) m"
         )
     out += wrong_side(garment, mesh)
+    out += sunk_pieces(garment)
     for sid, r in zip(garment.stroke_ids, garment.stroke_residual_m, strict=True):
         if not r <= STROKE_LOST_M:
             out.append(f"stroke {sid}: its cloth ended {100 * r:.0f} cm from the body stroke")
