@@ -80,16 +80,16 @@ def hangs_from_shoulders(positions: np.ndarray, surface: Surface, settings: FitS
 class _Sections:
     """The body's cross-sections (`body_section`) by height, each cut once (heights on one grid repeat)."""
 
-    def __init__(self, body: TriMesh):
-        self.body, self.cut = body, {}
-        heights = body.vertices[body.faces, 1]
+    def __init__(self, surface: Surface):
+        self.surface, self.cut = surface, {}
+        heights = surface.vertices[surface.faces, 1]
         self.low, self.high = heights.min(axis=1), heights.max(axis=1)
 
     def at(self, y: float) -> np.ndarray:
         key = round(y, 6)
         if key not in self.cut:
             near = (self.low <= key) & (self.high >= key)  # only the faces at that height are cut
-            self.cut[key] = body_section(TriMesh(self.body.vertices, self.body.faces[near]), key)
+            self.cut[key] = body_section(TriMesh(self.surface.vertices, self.surface.faces[near]), key)
         return self.cut[key]
 
 
@@ -123,17 +123,16 @@ def fitting_lift(
     positions: np.ndarray,
     faces: np.ndarray,
     rest_corners: np.ndarray,
-    body: TriMesh,
     surface: Surface,
     settings: FitSettings | None = None,
 ) -> float:
     """How far up (metres, >= 0) the garment resting on the body at `positions` (V, 3) metres (faces (F, 3),
-    rest_corners (F, 3, 2) metres: `ClothModel.rest_corners`) must go for its loops to fit the body (module
-    docstring): the smallest lift, in `step_m` steps up to `max_lift_m`, after which no loop is more than
-    `tolerance` too short; where none is, the one that leaves the worst loop least short, if that gains
+    rest_corners (F, 3, 2) metres: `ClothModel.rest_corners`; the body's `surface`) must go for its loops to fit
+    the body (module docstring): the smallest lift, in `step_m` steps up to `max_lift_m`, after which no loop is
+    more than `tolerance` too short; where none is, the one that leaves the worst loop least short, if that gains
     `min_gain`; 0 for a garment that fits, or hangs from the shoulders."""
     s = settings or FitSettings()
-    sections = _Sections(body)
+    sections = _Sections(surface)
     loops = body_loops(positions, faces, rest_corners, sections, s.step_m)
     here = shortfall(loops, sections, 0.0, s.margin_m)
     if here <= s.tolerance or hangs_from_shoulders(positions, surface, s):

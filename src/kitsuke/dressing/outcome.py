@@ -78,6 +78,20 @@ def mean_turn(placed: np.ndarray, worn: np.ndarray) -> float:
     return float(np.angle(np.exp(1j * t).sum())) if len(t) else 0.0
 
 
+def _placed_pieces(garment) -> list[tuple[int, np.ndarray, np.ndarray]]:
+    """For each piece of the garment's pattern with a placement: (piece index, its placed vertices (n, 3) metres,
+    the same vertices as worn (n, 3)); empty for a garment that does not carry its PatternMesh."""
+    pm = getattr(garment, "pattern_mesh", None)
+    vertex_of = getattr(garment, "pattern_vertex", None)
+    if pm is None or vertex_of is None or len(vertex_of) != pm.n_vertices:
+        return []
+    return [
+        (k, pm.positions_m[a:b], garment.positions[vertex_of[a:b]])
+        for k, (a, b) in enumerate(pm.piece_vertices)
+        if pm.placed[k]
+    ]
+
+
 def wrong_side_pieces(garment, mesh: TriMesh) -> list[tuple[int, str]]:
     """Pieces without a stroke that ended on the other side of the body from where their placement puts them (a
     skirt's front found hanging off the back left of the hip): (piece index, one line saying so) each. The strokes
@@ -85,17 +99,11 @@ def wrong_side_pieces(garment, mesh: TriMesh) -> list[tuple[int, str]]:
     turned as the stroked pieces turned theirs (on average round the body's vertical axis). Pieces with a stroke
     are judged by their strokes (`STROKE_LOST_M`), pieces without a placement not at all."""
     pm = getattr(garment, "pattern_mesh", None)
-    vertex_of = getattr(garment, "pattern_vertex", None)
-    if pm is None or vertex_of is None or len(vertex_of) != pm.n_vertices:
-        return []
     axis = body_axis(mesh)
     sides = {}  # piece -> (placed direction, worn direction)
-    for k in range(len(pm.piece_names)):
-        if not pm.placed[k]:
-            continue
-        a, b = pm.piece_vertices[k]
-        placed = pm.positions_m[a:b].mean(axis=0)[[0, 2]] - axis
-        worn = garment.positions[vertex_of[a:b]].mean(axis=0)[[0, 2]] - axis
+    for k, placed_xyz, worn_xyz in _placed_pieces(garment):
+        placed = placed_xyz.mean(axis=0)[[0, 2]] - axis
+        worn = worn_xyz.mean(axis=0)[[0, 2]] - axis
         if min(np.linalg.norm(placed), np.linalg.norm(worn)) >= SIDE_M:
             sides[k] = (placed, worn)
     stroked = sorted(_stroked_pieces(garment) & set(sides))
@@ -121,21 +129,14 @@ def sunk_pieces(garment) -> list[str]:
     by the stroked pieces' mean height change (their tops', as placed and as worn), one line each. A piece hangs
     from its top: a flared skirt's panel laid flat and then draped keeps its top at the waist, a waistband that
     slid down the legs does not. Only falls are judged: a piece placed under the floor ends higher."""
-    pm = getattr(garment, "pattern_mesh", None)
-    vertex_of = getattr(garment, "pattern_vertex", None)
-    if pm is None or vertex_of is None or len(vertex_of) != pm.n_vertices:
-        return []
-    tops = {}  # piece -> (placed top, worn top), metres
-    for k in range(len(pm.piece_names)):
-        if pm.placed[k]:
-            a, b = pm.piece_vertices[k]
-            tops[k] = (float(pm.positions_m[a:b, 1].max()), float(garment.positions[vertex_of[a:b], 1].max()))
+    tops = {k: (float(p[:, 1].max()), float(w[:, 1].max())) for k, p, w in _placed_pieces(garment)}  # metres
     stroked = _stroked_pieces(garment) & set(tops)
     if not stroked:
         return []
     moved = float(np.mean([tops[k][1] - tops[k][0] for k in stroked]))
+    names = garment.pattern_mesh.piece_names
     return [
-        f"piece {pm.piece_names[k]} ended {100 * (placed + moved - worn):.0f} cm below where its placement puts "
+        f"piece {names[k]} ended {100 * (placed + moved - worn):.0f} cm below where its placement puts "
         f"it (its top at {worn:.2f} m)"
         for k, (placed, worn) in tops.items()
         if k not in stroked and worn < placed + moved - SUNK_M

@@ -323,7 +323,6 @@ def settled_strokes(body, pattern: Pattern, strokes: Strokes, surface: Surface, 
     from .wrap import WrapParams, wrap
 
     quick = WrapParams().changed({"polish.rounds": 0, "tethers.reach_m": None})
-    mesh = body if isinstance(body, TriMesh) else body.mesh
     raised, out = 0.0, strokes
     for _ in range(FIT_ROUNDS if fit else 1):
         try:
@@ -332,7 +331,7 @@ def settled_strokes(body, pattern: Pattern, strokes: Strokes, surface: Surface, 
             break
         if not np.isfinite(g.positions).all():
             break
-        lift = fitting_lift(g.positions, g.faces, g.model.rest_corners, mesh, surface) if fit else 0.0
+        lift = fitting_lift(g.positions, g.faces, g.model.rest_corners, surface) if fit else 0.0
         pairs = []
         for pair, track in zip(out.pairs, g.tracks, strict=True):
             on = surface.closest(track.points(g.positions, g.faces) + [0.0, lift, 0.0]).points

@@ -514,8 +514,7 @@ def wrap(
             at = state.positions[worst].mean(axis=0)
             result.girth = garment_girth(state.positions, out_model.faces, out_model.rest_corners, mesh, at)
             if result.girth is not None and result.girth.short >= SHORT_SAID:
-                at_rest = (state.positions, out_model.faces, out_model.rest_corners)
-                result.fits_higher_m = fitting_lift(*at_rest, mesh, surface)
+                result.fits_higher_m = fitting_lift(state.positions, out_model.faces, out_model.rest_corners, surface)
         timings["report"] = time.perf_counter() - t6
     if check:
         bad = on_body_failures(result, body, surface=surface)
