@@ -12,7 +12,15 @@ import pytest
 from kitsuke.body import load_body
 from kitsuke.cloth import BodyCollider
 from kitsuke.dressing import SuggestParams, suggest_strokes, target_misses, wrap
-from kitsuke.dressing._fit_height import FitSettings, fitting_lift, hangs_from_shoulders
+from kitsuke.dressing._fit_height import (
+    FitSettings,
+    _Sections,
+    body_loops,
+    fitting_lift,
+    hangs_from_shoulders,
+    rise_limit,
+    shortfall,
+)
 from kitsuke.geometry import TriMesh
 from kitsuke.geometry.surface import Surface
 from kitsuke.metrics import QualityTargets
@@ -51,10 +59,12 @@ def waisted_body(n: int = 96, step: float = 0.005) -> TriMesh:
     return mesh
 
 
-def tube(girth: float, low: float, high: float, n: int = 64, m: int = 10):
-    """A tube of cloth of rest girth `girth` (metres) worn from y `low` to `high`, hugging the body 2 mm out
-    (stretched where the body is wider): positions (V, 3), faces (F, 3), rest_corners (F, 3, 2) metres."""
+def tube(girth: float, low: float, high: float, n: int = 64, m: int = 10, hem_girth: float | None = None):
+    """A tube of cloth of rest girth `girth` (metres; from `hem_girth` at its hem, `low`, growing or shrinking
+    evenly to `girth` at its top, `high`) worn from y `low` to `high`, hugging the body 2 mm out (stretched where
+    the body is wider): positions (V, 3), faces (F, 3), rest_corners (F, 3, 2) metres."""
     ys = np.linspace(low, high, m + 1)
+    girths = np.linspace(girth if hem_girth is None else hem_girth, girth, m + 1)
     t = 2 * np.pi * np.arange(n) / n
     ring = np.stack([np.sin(t), np.zeros(n), np.cos(t)], axis=1)
     pos = np.concatenate([ring * (radius(y) + 0.002) + [0.0, y, 0.0] for y in ys])
@@ -62,10 +72,12 @@ def tube(girth: float, low: float, high: float, n: int = 64, m: int = 10):
     for j in range(m):
         for i in range(n):
             a, b, c, d = j * n + i, j * n + (i + 1) % n, (j + 1) * n + i, (j + 1) * n + (i + 1) % n
-            u0, u1 = girth * i / n, girth * (i + 1) / n  # the last column closes the tube at u = girth, not 0
+            # the last column closes the tube at u = girth, not 0
+            u0, u1 = girths[j] * i / n, girths[j] * (i + 1) / n
+            w0, w1 = girths[j + 1] * i / n, girths[j + 1] * (i + 1) / n
             v0, v1 = ys[j] - low, ys[j + 1] - low
             faces += [[a, c, b], [b, c, d]]
-            rest += [[[u0, v0], [u0, v1], [u1, v0]], [[u1, v0], [u0, v1], [u1, v1]]]
+            rest += [[[u0, v0], [w0, v1], [u1, v0]], [[u1, v0], [w0, v1], [w1, v1]]]
     return pos, np.asarray(faces), np.asarray(rest)
 
 
@@ -102,6 +114,37 @@ def test_a_tube_that_fits_or_cannot_fit_by_rising_stays(waisted):
     # hips stay as wide for the first 10 cm; it stays.
     long = tube(2 * np.pi * 0.158, 0.80, 1.35)
     assert fitting_lift(*long, surface) == 0.0
+
+
+def test_a_garment_is_not_raised_past_the_waist_even_where_it_would_fit_higher(waisted):
+    """A 15 cm tube loose round the waist and tight round the hips (rest radius 0.15 m at its top, 0.14 m at its
+    hem: a tiered skirt whose lower tier is the smaller) would fit 23 cm up, its top round the ribs; it goes no
+    higher than where its top is 3 % wider than the waist (`rise_limit`)."""
+    surface = waisted
+    settings = FitSettings()
+    pos, faces, rest = tube(2 * np.pi * 0.15, 0.80, 0.95, hem_girth=2 * np.pi * 0.14)
+    sections = _Sections(surface)
+    loops = body_loops(pos, faces, rest, sections, settings.step_m)
+    assert shortfall(loops, sections, 0.24, settings.margin_m) <= settings.tolerance
+    # The body is 3 % wider than its waist (radius 0.135 m at 1.10 m) at radius 0.139 m, y 1.14 m: the top loop
+    # (0.945 m) may rise 19-20 cm.
+    limit = rise_limit(loops, sections, settings)
+    assert 0.185 <= limit <= 0.205
+    lift = fitting_lift(pos, faces, rest, surface)
+    assert lift <= limit and shortfall(loops, sections, lift, settings.margin_m) > settings.tolerance
+
+
+def test_a_garment_whose_top_is_above_the_waist_rises_as_far_as_it_needs(waisted):
+    """A 20 cm tube from the hips to above the waist (its top at 1.145 m, where the body widens again), 5 % short
+    round the hips: nothing above its top is narrower, so its rise is not limited (a strapless top slid down
+    under the bust, its hem round the hips), and it goes the 3 cm that make it fit."""
+    surface = waisted
+    settings = FitSettings()
+    pos, faces, rest = tube(2 * np.pi * 0.145, 0.95, 1.15, hem_girth=2 * np.pi * 0.149)
+    sections = _Sections(surface)
+    loops = body_loops(pos, faces, rest, sections, settings.step_m)
+    assert rise_limit(loops, sections, settings) == settings.max_lift_m
+    assert fitting_lift(pos, faces, rest, surface) == pytest.approx(0.03)
 
 
 def test_cloth_resting_on_skin_that_faces_up_hangs_from_it_and_is_not_raised(waisted):

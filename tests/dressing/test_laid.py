@@ -128,8 +128,20 @@ def test_the_unstroked_pieces_laid_at_their_placement_are_worn_where_it_puts_the
         slid = dataclasses.replace(g, positions=g.positions.copy())
         slid.positions[band, 1] -= drop
         lines = sunk_pieces(slid)
-        assert (len(lines) == 1 and re.match(r"piece wb_front ended \d+ cm below where", lines[0]) is not None) is said
+        # (the back waistband, its ends pulled down with the front's, sags too)
+        assert any(re.match(r"piece wb_front ended \d+ cm below where", line) for line in lines) is said
         assert any("wb_front ended" in line for line in on_body_failures(slid, body, surface=surface)) is said
+    # Its front waistband fallen into a sling, held at its ends and its middle pulled 20 cm down, sags; a dip of
+    # 5 cm is cloth at rest (`SAG_M`: 10 cm taller than its placement).
+    x = g.positions[band, 0]
+    middle = np.clip(1.0 - np.abs(x - x.mean()) / (0.5 * np.ptp(x)), 0.0, 1.0)  # 1 at the middle, 0 at the ends
+    for dip, said in ((0.20, True), (0.05, False)):
+        sagged = dataclasses.replace(g, positions=g.positions.copy())
+        sagged.positions[band, 1] -= dip * middle
+        lines = sunk_pieces(sagged)
+        assert (
+            len(lines) == 1 and re.match(r"piece wb_front sags: \d+ cm from top to bottom", lines[0]) is not None
+        ) is said
 
 
 def test_a_laid_piece_the_pattern_does_not_have_is_refused(skirt_on_back_stroke):

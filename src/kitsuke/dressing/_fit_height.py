@@ -6,9 +6,10 @@ the waist, dressed from strokes carried off that layout, rests 10 cm below its w
 hips and must stretch 38 % to go round them (measured on a sampled design: within every target once raised 10
 cm). A person pulls such a garment up until it sits; this does the same to a garment resting on the body: it
 cuts the cloth into horizontal loops (`kitsuke.metrics.worn_loop`) and finds the smallest lift after which no
-loop is more than `tolerance` shorter than the body's girth inside it at its new height. A garment that rests
-on the shoulders (a top, a dress) hangs from them and is never lifted; one that slid down from them in the
-settle (a shirt over a skirt that pulled it 7-15 cm down) is.
+loop is more than `tolerance` shorter than the body's girth inside it at its new height, its top going no higher
+than the waist (`rise_limit`: a skirt too small round the hips is out of target, not worn round the ribs). A
+garment that rests on the shoulders (a top, a dress) hangs from them and is never lifted; one that slid down from
+them in the settle (a shirt over a skirt that pulled it 7-15 cm down) is.
 """
 
 from __future__ import annotations
@@ -119,6 +120,32 @@ def shortfall(loops: list[tuple[WornLoop, float]], sections: _Sections, lift_m: 
     return float(worst)
 
 
+def rise_limit(loops: list[tuple[WornLoop, float]], sections: _Sections, settings: FitSettings) -> float:
+    """How far up (metres) the garment's top loop (`body_loops`) may go: where the body inside it is narrowest
+    within `max_lift_m` above it (the waist, for a garment whose top is below it), and on up to the last height,
+    in `step_m` steps, at which it is at most `tolerance` wider than there. A bottom is worn from its waist down: a
+    tiered skirt too small round the hips fits round the ribs too, 23 cm higher, and is a skirt no more.
+    `max_lift_m` where the body is narrowest at the top loop itself (a strapless top under the bust) or does not
+    widen again."""
+    top = max((loop for loop, _ in loops), key=lambda loop: loop.height_m, default=None)
+    if top is None:
+        return settings.max_lift_m
+    steps = int(round(settings.max_lift_m / settings.step_m))
+    girth = np.array(
+        [
+            tape_inside(sections.at(top.height_m + k * settings.step_m), top.ring, margin_m=settings.margin_m)
+            for k in range(steps + 1)
+        ]
+    )
+    girth[girth <= 0.0] = np.inf  # no body inside: no waist there
+    waist = int(np.argmin(girth))
+    if waist == 0 or not np.isfinite(girth[waist]):
+        return settings.max_lift_m
+    wider = np.flatnonzero(girth[waist:] > girth[waist] * (1.0 + settings.tolerance))
+    wider = wider[np.isfinite(girth[waist:][wider])]
+    return (waist + int(wider[0]) - 1) * settings.step_m if len(wider) else settings.max_lift_m
+
+
 def fitting_lift(
     positions: np.ndarray,
     faces: np.ndarray,
@@ -130,7 +157,7 @@ def fitting_lift(
     rest_corners (F, 3, 2) metres: `ClothModel.rest_corners`; the body's `surface`) must go for its loops to fit
     the body (module docstring): the smallest lift, in `step_m` steps up to `max_lift_m`, after which no loop is
     more than `tolerance` too short; where none is, the one that leaves the worst loop least short, if that gains
-    `min_gain`; 0 for a garment that fits, or hangs from the shoulders."""
+    `min_gain`; never past `rise_limit`; 0 for a garment that fits, or hangs from the shoulders."""
     s = settings or FitSettings()
     sections = _Sections(surface)
     loops = body_loops(positions, faces, rest_corners, sections, s.step_m)
@@ -138,7 +165,10 @@ def fitting_lift(
     if here <= s.tolerance or hangs_from_shoulders(positions, surface, s):
         return 0.0
     best_lift, best = 0.0, here
+    highest = rise_limit(loops, sections, s)
     for lift in np.arange(1, int(round(s.max_lift_m / s.step_m)) + 1) * s.step_m:
+        if lift > highest + 1e-9:
+            break
         worst = shortfall(loops, sections, float(lift), s.margin_m)
         if worst <= s.tolerance:
             return float(lift)

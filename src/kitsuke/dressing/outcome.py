@@ -47,6 +47,12 @@ SAME_TURN_DEG = 20.0
 #: up or down as the stroked pieces were, has fallen off where it is worn (a skirt's waistband found round the
 #: knees).
 SUNK_M = 0.25
+#: A piece without a stroke whose height (top to bottom) ended more than this much taller than its placement's,
+#: metres, and more than `SAG_SHARE` of that taller, sags from its ends: a waistband 40-60 % longer than the hips
+#: held by a stroke at the front, its back fallen 14-16 cm into a sling under the buttocks (its height 9-14 ->
+#: 25 cm; its top, held at the sides, fell 4-10 cm). Flat-laid skirt panels that drape grow shorter, not taller.
+SAG_M = 0.10
+SAG_SHARE = 0.5
 
 
 def _side(v: np.ndarray) -> str:
@@ -125,22 +131,32 @@ def wrong_side_pieces(garment, mesh: TriMesh) -> list[tuple[int, str]]:
 
 
 def sunk_pieces(garment) -> list[str]:
-    """Pieces without a stroke whose top ended more than `SUNK_M` below their placement's top, moved up or down
-    by the stroked pieces' mean height change (their tops', as placed and as worn), one line each. A piece hangs
-    from its top: a flared skirt's panel laid flat and then draped keeps its top at the waist, a waistband that
-    slid down the legs does not. Only falls are judged: a piece placed under the floor ends higher."""
-    tops = {k: (float(p[:, 1].max()), float(w[:, 1].max())) for k, p, w in _placed_pieces(garment)}  # metres
+    """Pieces without a stroke that fell from where their placement puts them, one line each: their top ended
+    more than `SUNK_M` below their placement's top, moved up or down by the stroked pieces' mean height change
+    (their tops', as placed and as worn), or they sag (`SAG_M`). A piece hangs from its top: a flared skirt's
+    panel laid flat and then draped keeps its top at the waist, a waistband that slid down the legs does not. Only
+    falls are judged: a piece placed under the floor ends higher."""
+    placed_pieces = _placed_pieces(garment)
+    tops = {k: (float(p[:, 1].max()), float(w[:, 1].max())) for k, p, w in placed_pieces}  # metres
     stroked = _stroked_pieces(garment) & set(tops)
-    if not stroked:
-        return []
-    moved = float(np.mean([tops[k][1] - tops[k][0] for k in stroked]))
-    names = garment.pattern_mesh.piece_names
-    return [
-        f"piece {names[k]} ended {100 * (placed + moved - worn):.0f} cm below where its placement puts "
-        f"it (its top at {worn:.2f} m)"
-        for k, (placed, worn) in tops.items()
-        if k not in stroked and worn < placed + moved - SUNK_M
-    ]
+    names = garment.pattern_mesh.piece_names if placed_pieces else []
+    out = []
+    if stroked:  # the garment's own move, to judge the others' tops by
+        moved = float(np.mean([tops[k][1] - tops[k][0] for k in stroked]))
+        out += [
+            f"piece {names[k]} ended {100 * (placed + moved - worn):.0f} cm below where its placement puts "
+            f"it (its top at {worn:.2f} m)"
+            for k, (placed, worn) in tops.items()
+            if k not in stroked and worn < placed + moved - SUNK_M
+        ]
+    for k, placed, worn in placed_pieces:
+        tall, now = float(np.ptp(placed[:, 1])), float(np.ptp(worn[:, 1]))
+        if k not in stroked and now - tall > max(SAG_M, SAG_SHARE * tall):
+            out.append(
+                f"piece {names[k]} sags: {100 * now:.0f} cm from top to bottom where its placement is "
+                f"{100 * tall:.0f} cm (down to {worn[:, 1].min():.2f} m)"
+            )
+    return out
 
 
 def wrong_side(garment, mesh: TriMesh) -> list[str]:
