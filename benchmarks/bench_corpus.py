@@ -27,7 +27,7 @@ before the drag and over all written.
 With `--batch local` or `--batch ray` the designs are dressed as one `kitsuke batch dress` batch (`--workers`
 workers): each job suggests its strokes and perturbs them with the same seed as here (the manifest's `perturb`
 column), and is sorted the same way from its record and OBJ (garbage: `insane` on the OBJ's positions); it must
-give every design the class the plain run gives. --drag and --set are for the plain run.
+give every design the class the plain run gives. --drag is for the plain run.
 """
 
 from __future__ import annotations
@@ -155,9 +155,11 @@ def dressed_how(laid: list[str], sewn: bool) -> str:
     return "+".join(["laid"] * bool(laid) + ["sewn"] * bool(sewn)) or "grown"
 
 
-def batch_jobs(paths: list[Path], perturb: bool) -> list:
-    """kitsuke.batch dress jobs of the designs: suggested strokes, perturbed with rng_of's seed, robust targets."""
+def batch_jobs(paths: list[Path], perturb: bool, settings: tuple = ()) -> list:
+    """kitsuke.batch dress jobs of the designs: suggested strokes, perturbed with rng_of's seed, robust targets;
+    `settings` ((name, value) pairs, as `DressOptions.settings`) change the wrap's."""
     from kitsuke.batch import BodySource, Job
+    from kitsuke.dressing.options import DressOptions
 
     return [
         Job(
@@ -165,6 +167,7 @@ def batch_jobs(paths: list[Path], perturb: bool) -> list:
             body=BodySource(str(BODY)),
             pattern=str(path),
             strokes=None,
+            options=DressOptions(settings=tuple(settings)),
             perturb=zlib.crc32(path.stem.encode()) if perturb else None,
             targets="robust",
             glb=False,
@@ -173,13 +176,15 @@ def batch_jobs(paths: list[Path], perturb: bool) -> list:
     ]
 
 
-def dress_batch(paths: list[Path], surface, perturb: bool, runner: str, workers: int | None) -> list[dict]:
+def dress_batch(
+    paths: list[Path], surface, perturb: bool, runner: str, workers: int | None, settings: tuple = ()
+) -> list[dict]:
     """The designs dressed as one batch (kitsuke.batch, `runner` "local" or "ray"), as rows like dress_one's."""
     from kitsuke.batch import DressKind, LocalRunner, RayRunner, run_batch
     from kitsuke.dressing import read_strokes
     from kitsuke.dressing.export import read_garment_obj
 
-    jobs = batch_jobs(paths, perturb)
+    jobs = batch_jobs(paths, perturb, settings)
     make = LocalRunner if runner == "local" else RayRunner
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -271,8 +276,8 @@ def main() -> None:
     ap.add_argument("--batch", choices=["local", "ray"], help="dress them as one kitsuke.batch batch on this runner")
     ap.add_argument("--workers", type=int, default=None, help="--batch: workers (default: one per core)")
     args = ap.parse_args()
-    if args.batch and (args.drag or args.set):
-        sys.exit("--drag and --set are for the plain run, not --batch")
+    if args.batch and args.drag:
+        sys.exit("--drag is for the plain run, not --batch")
 
     from kitsuke.body import load_body
     from kitsuke.cloth import BodyCollider
@@ -293,7 +298,9 @@ def main() -> None:
             paths = sorted(folder.glob("*_specification.json")) or sample(seed, args.n, folder, args.sampler)
             paths = [p for p in paths if not args.only or any(o in p.stem for o in args.only)]
             if args.batch:
-                done = dress_batch(paths, surface, not args.no_perturb, args.batch, args.workers)
+                done = dress_batch(
+                    paths, surface, not args.no_perturb, args.batch, args.workers, tuple(changes.items())
+                )
             else:
                 done = (
                     dress_one(p, body, collider, surface, rng_of(p), not args.no_perturb, args.drag, params)
