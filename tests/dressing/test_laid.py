@@ -37,6 +37,9 @@ from ..conftest import DATA
 SKIRT = DATA / "pattern" / "corpus" / "gc_s101_0003_specification.json"
 SEWN_TOP = DATA / "pattern" / "corpus" / "gc_s6297_0004_specification.json"
 TORN_SHIRT = DATA / "pattern" / "corpus" / "gc_s2718_0026_specification.json"
+#: Strokes let go where the settle moved them more than 5 cm (`tethers.slack_m` before it was 8 cm): the relay's
+#: tests need garments whose first try fails.
+LET_GO_AT_5_CM = {"tethers.slack_m": 0.05}
 
 
 def _turned(p: np.ndarray, degrees: float, axis: np.ndarray) -> np.ndarray:
@@ -170,16 +173,18 @@ def test_a_shirt_growth_tears_is_dressed_with_every_piece_laid(run_cli, tmp_path
     """GarmentCode's shirt (tests corpus, seed 2718): grown from its strokes as a hand drew them, the front's side
     goes over the upper arm and the side seam closes with the arm inside the torso, and the wrap fails; dressed
     once more with every piece laid at its placement and sewn by the close, it is worn within the targets.
-    `kitsuke dress` says why it dressed twice."""
+    `kitsuke dress` says why it dressed twice. (Strokes the settle moved 5-8 cm are let go here, as before
+    `tethers.slack_m` was 8 cm: held, this shirt dresses grown.)"""
     body, collider, _, pattern, strokes = _on_mean_all(TORN_SHIRT)
     with pytest.raises(ComputationError, match="wrap: not a garment on the body") as first:
-        alone = WrapParams().changed({"grow.relay": False, "close.sew_on_failure": False})
+        alone = WrapParams().changed({"grow.relay": False, "close.sew_on_failure": False, **LET_GO_AT_5_CM})
         wrap(body, pattern, strokes, collider=collider, params=alone)
     write_strokes(strokes, tmp_path / "strokes.json")
     out = tmp_path / "shirt.glb"
     r = run_cli(
         "dress", "--body", DATA / "bodies" / "mean_all.obj", "--pattern", TORN_SHIRT,
         "--strokes", tmp_path / "strokes.json", "-o", out, "--report", tmp_path / "shirt.json",
+        "--set", "tethers.slack_m=0.05",
     )  # fmt: skip
     assert r.code == 0, r.err
     assert f"first try: {first.value.message}; dressed again with every piece laid at the placement" in r.err
@@ -210,12 +215,12 @@ def test_laid_trousers_close_round_the_legs_not_through_them():
 def test_a_garment_that_fails_grown_and_laid_is_written_with_its_seams_sewn():
     """A fitted top over a pencil skirt (tests corpus), suggested where it rests (raised to fit, it dresses grown),
     fails grown (a stroke's cloth 7 cm off) and laid; the last try sews its seams (`kitsuke.cloth.sew`) and the
-    garment is on the body: written, not refused."""
+    garment is on the body: written, not refused. (Strokes the settle moved 5-8 cm let go, as in the first test.)"""
     body, collider, surface, pattern, strokes = _on_mean_all(SEWN_TOP, raise_=False)
-    unsewn = WrapParams().changed({"close.sew_on_failure": False})
+    unsewn = WrapParams().changed({"close.sew_on_failure": False, **LET_GO_AT_5_CM})
     with pytest.raises(ComputationError) as first:
         wrap(body, pattern, strokes, collider=collider, params=unsewn)
-    garment = wrap(body, pattern, strokes, collider=collider)
+    garment = wrap(body, pattern, strokes, collider=collider, params=WrapParams().changed(LET_GO_AT_5_CM))
     assert garment.sewn and garment.laid == [] and garment.redone_after == first.value.message
     assert on_body_failures(garment, body, surface=surface) == []
     assert np.isfinite(garment.positions).all() and garment.report.strain_max < 1.0
