@@ -141,8 +141,8 @@ def rise_limit(loops: list[tuple[WornLoop, float]], sections: _Sections, setting
     waist = int(np.argmin(girth))
     if waist == 0 or not np.isfinite(girth[waist]):
         return settings.max_lift_m
-    wider = np.flatnonzero(girth[waist:] > girth[waist] * (1.0 + settings.tolerance))
-    wider = wider[np.isfinite(girth[waist:][wider])]
+    above = girth[waist:]
+    wider = np.flatnonzero(np.isfinite(above) & (above > girth[waist] * (1.0 + settings.tolerance)))
     return (waist + int(wider[0]) - 1) * settings.step_m if len(wider) else settings.max_lift_m
 
 

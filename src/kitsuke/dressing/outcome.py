@@ -48,9 +48,9 @@ SAME_TURN_DEG = 20.0
 #: knees).
 SUNK_M = 0.25
 #: A piece without a stroke whose height (top to bottom) ended more than this much taller than its placement's,
-#: metres, and more than `SAG_SHARE` of that taller, sags from its ends: a waistband 40-60 % longer than the hips
-#: held by a stroke at the front, its back fallen 14-16 cm into a sling under the buttocks (its height 9-14 ->
-#: 25 cm; its top, held at the sides, fell 4-10 cm). Flat-laid skirt panels that drape grow shorter, not taller.
+#: metres, and more than `SAG_SHARE` of that taller, sags from its ends: a waistband 15-35 % longer than the hips
+#: held by one stroke, its other half fallen 11-21 cm into a sling under the buttocks (its height 9-14 -> 24-26
+#: cm; its top, held at the sides, fell at most 10 cm). Flat-laid skirt panels that drape grow shorter, not taller.
 SAG_M = 0.10
 SAG_SHARE = 0.5
 
