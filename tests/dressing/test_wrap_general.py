@@ -17,8 +17,9 @@ from kitsuke.dressing import (
     target_misses,
     wrap,
 )
-from kitsuke.errors import ComputationError
+from kitsuke.errors import ComputationError, InputError
 from kitsuke.metrics import QualityTargets
+from kitsuke.pattern import EdgeRef, Pattern, Piece, Seam, sliver_pieces
 
 from .test_wrap import _sphere, _square
 
@@ -173,3 +174,32 @@ def test_a_garment_on_the_body_reports_the_targets_it_misses(drawn_up):
     assert any(m.startswith("max edge strain") for m in misses)
     assert any("farther than 0.1 mm from where drawn" in m for m in misses)
     assert drawn_up.summary()["targets_missed"] == target_misses(drawn_up)
+
+
+def _with_hem_strip(height_cm: float) -> Pattern:
+    """The square with a strip `height_cm` tall sewn under its bottom edge, as GarmentCode's sampler sews a cuff
+    0.25 mm tall under a trouser leg."""
+    square = _square()
+    strip = Piece("strip", np.array([[0.0, -height_cm], [20.0, -height_cm], [20.0, 0.0], [0.0, 0.0]]))
+    return Pattern("sheet", [*square.pieces, strip], [Seam(EdgeRef("square", 0), EdgeRef("strip", 2))])
+
+
+def test_a_sliver_is_left_out_of_the_wrap_and_said(sphere, drawn_up):
+    """A piece narrower on average than 5 mm meshes into needle triangles a fraction of a millimetre across that
+    any wrinkle tears (the sampler's 0.25 mm cuffs failed their wraps as torn): the wrap leaves it out and says so;
+    a 1 cm strip is worn."""
+    thin = _with_hem_strip(0.025)
+    assert sliver_pieces(thin) == {"strip": pytest.approx(0.025, rel=0.01)}
+    assert thin.without(["strip"]).piece_names == ["square"] and thin.without(["strip"]).seams == []
+    g = wrap(sphere, thin, _upright(_meridian(0.3, 0.16)), params=PARAMS)
+    assert g.piece_names == ["square"] and list(g.left_out) == ["strip"]
+    assert g.summary()["left_out_pieces"] == {"strip": {"mean_width_mm": pytest.approx(0.25, rel=0.01)}}
+    assert g.n_vertices == drawn_up.n_vertices and not on_body_failures(g, sphere)
+    wide = wrap(sphere, _with_hem_strip(1.0), _upright(_meridian(0.3, 0.16)), params=PARAMS)
+    assert wide.piece_names == ["square", "strip"] and wide.left_out == {}
+    # A stroke drawn on the sliver is refused, naming it.
+    on_strip = Strokes(
+        [StrokePair(1, PatternStroke("strip", [[2.0, -0.01], [18.0, -0.01]]), BodyStroke(points=_meridian(0.3, 0.16)))]
+    )
+    with pytest.raises(InputError, match="stroke 1 is drawn on piece 'strip', a sliver 0.25 mm wide"):
+        wrap(sphere, thin, on_strip, params=PARAMS)

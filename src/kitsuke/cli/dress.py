@@ -181,8 +181,10 @@ def run(args: argparse.Namespace) -> int:
             print(f"kept the failed result as {failed[0]} for inspection", file=sys.stderr)
         raise
     write_garment_outputs(garment, body.mesh, glb, obj, report, png)
+    for name, width in garment.left_out.items():
+        print(f"left out piece {name!r}: a sliver {width * 10:.2g} mm wide on average", file=sys.stderr)
     if garment.redone_after:
-        laid = "every piece" if set(garment.laid) >= set(pattern.piece_names) else ", ".join(garment.laid)
+        laid = "every piece" if set(garment.laid) >= set(garment.piece_names) else ", ".join(garment.laid)
         how = " and ".join(
             ([f"{laid} laid at the placement"] if garment.laid else []) + (["its seams sewn"] if garment.sewn else [])
         )

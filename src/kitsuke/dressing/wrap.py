@@ -78,7 +78,7 @@ from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, RefinedPo
 from ..errors import ComputationError, InputError
 from ..geometry import TriMesh
 from ..metrics import Girth, QualityReport, QualityTargets, garment_girth, quality_report, strain
-from ..pattern import Pattern, PatternMesh, face_layers, mesh_pattern
+from ..pattern import Pattern, PatternMesh, face_layers, mesh_pattern, sliver_pieces
 from ._bridge import bridged, spans_legs
 from ._fit_height import fitting_lift
 from ._gather import Gather, gathered_rest
@@ -137,6 +137,7 @@ class DressedGarment:
         try failed, `sew_on_failure`). redone_after : why the wrap dressed the garment once more
         (`GrowSettings.relay`, `CloseSettings.sew_on_failure`): the first try's failure, one line; "" when the
         first try was kept.
+    left_out : {piece name: mean width, cm} of the slivers left out of the wrap (`_without_slivers`).
     rings : growth rings. mend : what `_mend.mend_tears` did after the close (rounds, torn edges before and
         after). polished : the polish's result was kept (`PolishSettings.rounds`). timings : seconds per step
         ("mesh", "resolve", "place", "grow", "close", "settle", "finish", "untangle", "polish", "wrap" = all of
@@ -165,6 +166,7 @@ class DressedGarment:
     loose_strokes: list[int] = field(default_factory=list)
     gathers: list[Gather] = field(default_factory=list)
     laid: list[str] = field(default_factory=list)
+    left_out: dict[str, float] = field(default_factory=dict)
     sewn: bool = False
     redone_after: str = ""
     rings: int = 0
@@ -200,6 +202,7 @@ class DressedGarment:
             "loose_strokes": list(self.loose_strokes),
             "gathered_seams": [dataclasses.asdict(g) | {"ratio": round(g.ratio, 4)} for g in self.gathers],
             "laid_pieces": list(self.laid),
+            "left_out_pieces": {name: {"mean_width_mm": round(w * 10.0, 3)} for name, w in self.left_out.items()},
             "seams_sewn": self.sewn,
             "redone_after": self.redone_after,
             "timings_s": {k: round(v, 4) for k, v in self.timings.items()},
@@ -303,9 +306,10 @@ def wrap(
     say = progress or (lambda _stage: None)
     t0 = time.perf_counter()
     say("meshing")
+    left_out: dict[str, float] = {}
     if isinstance(garment, Pattern):
-        pattern = garment
-        pm = mesh_pattern(garment, edge_length=p.edge_length_cm)
+        pattern, left_out = _without_slivers(garment, strokes)
+        pm = mesh_pattern(pattern, edge_length=p.edge_length_cm)
     elif isinstance(garment, PatternMesh):
         pm = garment
     else:
@@ -494,6 +498,7 @@ def wrap(
         loose_strokes=[tr.id for tr, far in zip(placement.tracks, loose, strict=True) if far],
         gathers=gathers,
         laid=[pm.piece_names[k] for k in laid],
+        left_out=left_out,
         sewn=bool(p.close.sew_frames),
         rings=grown["rings"],
         polished=done.polished,
@@ -555,6 +560,26 @@ def wrap(
                 return redone
             raise failure
     return result
+
+
+def _without_slivers(pattern: Pattern, strokes: Strokes) -> tuple[Pattern, dict[str, float]]:
+    """`pattern` without its slivers (`kitsuke.pattern.sliver_pieces`: narrower on average than 5 mm) and their
+    seams, and {name: mean width cm} of those left out. Why: a sliver meshes into needle triangles whose edges are
+    a fraction of a millimetre across, so any wrinkle tears it (GarmentCode's sampler cuts trouser cuffs 0.25 mm
+    tall: an edge at 3.6x its length failed the wrap), and cloth that narrow is no part of the garment anyone sees.
+    A pattern made only of slivers is kept whole (its wrap fails where it tears). InputError where a stroke is
+    drawn on one."""
+    thin = sliver_pieces(pattern)
+    if not thin or len(thin) == len(pattern.pieces):
+        return pattern, {}
+    for pair in strokes.pairs:
+        if pair.pattern.piece in thin:
+            raise InputError(
+                f"stroke {pair.id} is drawn on piece {pair.pattern.piece!r}, a sliver "
+                f"{thin[pair.pattern.piece] * 10:.2g} mm wide that the wrap leaves out: draw it on a neighbour",
+                strokes.source or None,
+            )
+    return pattern.without(thin), thin
 
 
 def _tethers(tracks: list[StrokeTrack], loose: np.ndarray, faces: np.ndarray, reach_m: float) -> Tethers:

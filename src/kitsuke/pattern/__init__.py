@@ -20,7 +20,7 @@ from ._layers import LayerRegion, face_layers, pattern_layers
 from ._mesh import PatternMesh, mesh_pattern, mesh_quality, obj_text, write_pattern_obj
 from ._svg_import import read_svg
 from ._types import Curve, CurveType, EdgeRef, Fold, Pattern, Piece, Placement, Seam
-from ._validate import Issue, check_pattern, validate
+from ._validate import Issue, check_pattern, sliver_pieces, validate
 from .kimono import KimonoSize, default_kimono, fitted_size, make_kimono
 from .texture import MOTIFS, PALETTES, kimono_texture, texture_tile_size_cm, texture_uv
 
@@ -66,6 +66,7 @@ __all__ = [
     "sheet_to_svg",
     "texture_tile_size_cm",
     "texture_uv",
+    "sliver_pieces",
     "validate",
     "write_kitsuke",
     "write_pattern_obj",

@@ -19,7 +19,9 @@ checks (self-intersection, seams naming unknown edges, length mismatches) live i
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -358,6 +360,16 @@ class Pattern:
     meta: dict[str, Any] = field(default_factory=dict)
     file_mirrored: frozenset[str] = field(default_factory=frozenset, compare=False)
     source: str | None = field(default=None, compare=False)
+
+    def without(self, names: Iterable[str]) -> Pattern:
+        """This pattern without the pieces `names` and every seam sewn to them (a new Pattern; pieces shared)."""
+        drop = set(names)
+        return dataclasses.replace(
+            self,
+            pieces=[p for p in self.pieces if p.name not in drop],
+            seams=[s for s in self.seams if s.a.piece not in drop and s.b.piece not in drop],
+            file_mirrored=self.file_mirrored - drop,
+        )
 
     def file_to_piece(self, piece: str, points: np.ndarray) -> np.ndarray:
         """Points (n, 2) cm in the coordinates of the file the pattern came from -> the piece's own (a copy)."""

@@ -112,19 +112,36 @@ def _piece_issues(piece) -> list[Issue]:
             )
         )
     else:
-        perimeter = float(np.linalg.norm(poly - np.roll(poly, -1, axis=0), axis=1).sum())
-        width = 2.0 * area / perimeter
+        width, perimeter = _mean_width(poly, area)
         if width < SLIVER_CM:
             out.append(
                 Issue(
                     "warning",
                     "sliver",
                     f"piece {name!r}: {width * 10:.2g} mm wide on average ({area:.2g} cm² over "
-                    f"{perimeter / 2:.3g} cm): a sliver whose mesh is needle triangles; widen it or sew its "
-                    "neighbours to each other",
+                    f"{perimeter / 2:.3g} cm): a sliver whose mesh is needle triangles; the wrap leaves it out "
+                    "(widen it, or sew its neighbours to each other)",
                     name,
                 )
             )
+    return out
+
+
+def _mean_width(poly: np.ndarray, area: float) -> tuple[float, float]:
+    """A piece's mean width, twice its area over its perimeter (a strip's width), and its perimeter; cm."""
+    perimeter = float(np.linalg.norm(poly - np.roll(poly, -1, axis=0), axis=1).sum())
+    return 2.0 * area / perimeter, perimeter
+
+
+def sliver_pieces(pattern: Pattern) -> dict[str, float]:
+    """{name: mean width (cm)} of the pieces narrower on average than SLIVER_CM (`validate`'s "sliver" warning),
+    in pattern order. Assumes a valid pattern (as `load_pattern` gives)."""
+    out = {}
+    for piece in pattern.pieces:
+        poly, _ = piece.polygon_with_edges(tol_cm=INTERSECTION_TOL_CM)
+        width, _ = _mean_width(poly, abs(geo.signed_area(poly)))
+        if width < SLIVER_CM:
+            out[piece.name] = width
     return out
 
 
