@@ -170,9 +170,9 @@ def polish_step(
                 best = None
                 rp.state = limited
                 break
-            rp.state = limited
             if not gained:
                 break
+            rp.state = limited
         if best is not None:
             rp.state = best[1]
     return is_better(model, state, rp.model, rp.state, residual_of, collider, rp), rp
