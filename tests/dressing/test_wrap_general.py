@@ -13,6 +13,7 @@ from kitsuke.dressing import (
     StrokePair,
     Strokes,
     WrapParams,
+    check_strokes,
     on_body_failures,
     target_misses,
     wrap,
@@ -203,3 +204,7 @@ def test_a_sliver_is_left_out_of_the_wrap_and_said(sphere, drawn_up):
     )
     with pytest.raises(InputError, match="stroke 1 is drawn on piece 'strip', a sliver 0.25 mm wide"):
         wrap(sphere, thin, on_strip, params=PARAMS)
+    # ... and so it is by the check that `kitsuke dress` and `kitsuke strokes check` run before loading the body.
+    with pytest.raises(InputError, match="stroke 1 is drawn on piece 'strip', a sliver 0.25 mm wide"):
+        check_strokes(on_strip, thin)
+    check_strokes(_upright(_meridian(0.3, 0.16)), thin)  # a stroke on the square is fine

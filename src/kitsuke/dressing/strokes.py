@@ -44,7 +44,7 @@ from .._files import read_json, write_text_atomic
 from ..errors import InputError
 from ..geometry.mesh import TriMesh
 from ..geometry.surface import RayHit, Surface, SurfacePoints
-from ..pattern import Pattern, PatternMesh
+from ..pattern import Pattern, PatternMesh, sliver_pieces
 from ._crossing import segments_cross_triangles
 from ._polyline import (
     arc_length,
@@ -418,10 +418,26 @@ def check_strokes(strokes: Strokes, pattern: Pattern, *, pattern_mesh: PatternMe
     """Check the pattern side of every stroke; InputError naming the strokes file and the stroke id.
 
     Pattern points are in the coordinates of the pattern's file (`in_piece_frame`). Each pattern stroke must
-    name a piece of `pattern`; its points, and its path sampled every 0.5 cm, must lie on the piece (curved
-    edges included) to within 1 mm; given `pattern_mesh`, it must cross at least one triangle of its piece there.
+    name a piece of `pattern` that is not a sliver (the wrap leaves those out: `refuse_strokes_on_slivers`); its
+    points, and its path sampled every 0.5 cm, must lie on the piece (curved edges included) to within 1 mm; given
+    `pattern_mesh`, it must cross at least one triangle of its piece there.
     """
     _check_on_pieces(in_piece_frame(strokes, pattern), pattern, pattern_mesh)
+    thin = sliver_pieces(pattern)
+    if len(thin) < len(pattern.pieces):  # a pattern of slivers only is wrapped whole
+        refuse_strokes_on_slivers(strokes, thin)
+
+
+def refuse_strokes_on_slivers(strokes: Strokes, thin: dict[str, float]) -> None:
+    """InputError for the first stroke drawn on one of the pieces `thin` ({name: mean width cm}, from
+    `kitsuke.pattern.sliver_pieces`), which the wrap leaves out of the garment."""
+    for pair in strokes.pairs:
+        if pair.pattern.piece in thin:
+            raise InputError(
+                f"stroke {pair.id} is drawn on piece {pair.pattern.piece!r}, a sliver "
+                f"{thin[pair.pattern.piece] * 10:.2g} mm wide that the wrap leaves out: draw it on a neighbour",
+                strokes.source or None,
+            )
 
 
 def _check_on_pieces(strokes: Strokes, pattern: Pattern, pattern_mesh: PatternMesh | None) -> None:

@@ -106,7 +106,7 @@ from ._stages import (
 )
 from ._weld import repair_corners, weld
 from .outcome import SHORT_SAID, body_axis, on_body_failures, target_misses, wrong_side_pieces
-from .strokes import Strokes, resolve_strokes
+from .strokes import Strokes, refuse_strokes_on_slivers, resolve_strokes
 from .wrap_settings import SEW_FRAMES, WrapParams
 
 
@@ -572,13 +572,7 @@ def _without_slivers(pattern: Pattern, strokes: Strokes) -> tuple[Pattern, dict[
     thin = sliver_pieces(pattern)
     if not thin or len(thin) == len(pattern.pieces):
         return pattern, {}
-    for pair in strokes.pairs:
-        if pair.pattern.piece in thin:
-            raise InputError(
-                f"stroke {pair.id} is drawn on piece {pair.pattern.piece!r}, a sliver "
-                f"{thin[pair.pattern.piece] * 10:.2g} mm wide that the wrap leaves out: draw it on a neighbour",
-                strokes.source or None,
-            )
+    refuse_strokes_on_slivers(strokes, thin)
     return pattern.without(thin), thin
 
 
