@@ -418,19 +418,20 @@ def check_strokes(strokes: Strokes, pattern: Pattern, *, pattern_mesh: PatternMe
     """Check the pattern side of every stroke; InputError naming the strokes file and the stroke id.
 
     Pattern points are in the coordinates of the pattern's file (`in_piece_frame`). Each pattern stroke must
-    name a piece of `pattern` that is not a sliver (the wrap leaves those out: `refuse_strokes_on_slivers`); its
+    name a piece of `pattern` that is not a sliver (the wrap leaves those out: `slivers_left_out`); its
     points, and its path sampled every 0.5 cm, must lie on the piece (curved edges included) to within 1 mm; given
     `pattern_mesh`, it must cross at least one triangle of its piece there.
     """
     _check_on_pieces(in_piece_frame(strokes, pattern), pattern, pattern_mesh)
+
+
+def slivers_left_out(strokes: Strokes, pattern: Pattern) -> dict[str, float]:
+    """{name: mean width cm} of the pieces the wrap leaves out of `pattern`: its slivers
+    (`kitsuke.pattern.sliver_pieces`), unless it has nothing else (then it is wrapped whole). InputError for the
+    first stroke drawn on one."""
     thin = sliver_pieces(pattern)
-    if len(thin) < len(pattern.pieces):  # a pattern of slivers only is wrapped whole
-        refuse_strokes_on_slivers(strokes, thin)
-
-
-def refuse_strokes_on_slivers(strokes: Strokes, thin: dict[str, float]) -> None:
-    """InputError for the first stroke drawn on one of the pieces `thin` ({name: mean width cm}, from
-    `kitsuke.pattern.sliver_pieces`), which the wrap leaves out of the garment."""
+    if len(thin) == len(pattern.pieces):
+        return {}
     for pair in strokes.pairs:
         if pair.pattern.piece in thin:
             raise InputError(
@@ -438,10 +439,12 @@ def refuse_strokes_on_slivers(strokes: Strokes, thin: dict[str, float]) -> None:
                 f"{thin[pair.pattern.piece] * 10:.2g} mm wide that the wrap leaves out: draw it on a neighbour",
                 strokes.source or None,
             )
+    return thin
 
 
 def _check_on_pieces(strokes: Strokes, pattern: Pattern, pattern_mesh: PatternMesh | None) -> None:
     """`check_strokes` for strokes already in the pieces' own coordinates."""
+    slivers_left_out(strokes, pattern)
     path = strokes.source or None
     polygons: dict[str, np.ndarray] = {}
     for pair in strokes.pairs:

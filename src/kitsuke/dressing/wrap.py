@@ -78,7 +78,7 @@ from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, RefinedPo
 from ..errors import ComputationError, InputError
 from ..geometry import TriMesh
 from ..metrics import Girth, QualityReport, QualityTargets, garment_girth, quality_report, strain
-from ..pattern import Pattern, PatternMesh, face_layers, mesh_pattern, sliver_pieces
+from ..pattern import Pattern, PatternMesh, face_layers, mesh_pattern
 from ._bridge import bridged, spans_legs
 from ._fit_height import fitting_lift
 from ._gather import Gather, gathered_rest
@@ -106,7 +106,7 @@ from ._stages import (
 )
 from ._weld import repair_corners, weld
 from .outcome import SHORT_SAID, body_axis, on_body_failures, target_misses, wrong_side_pieces
-from .strokes import Strokes, refuse_strokes_on_slivers, resolve_strokes
+from .strokes import Strokes, resolve_strokes, slivers_left_out
 from .wrap_settings import SEW_FRAMES, WrapParams
 
 
@@ -137,7 +137,7 @@ class DressedGarment:
         try failed, `sew_on_failure`). redone_after : why the wrap dressed the garment once more
         (`GrowSettings.relay`, `CloseSettings.sew_on_failure`): the first try's failure, one line; "" when the
         first try was kept.
-    left_out : {piece name: mean width, cm} of the slivers left out of the wrap (`_without_slivers`).
+    left_out : {piece name: mean width, cm} of the slivers left out of the wrap (`strokes.slivers_left_out`).
     rings : growth rings. mend : what `_mend.mend_tears` did after the close (rounds, torn edges before and
         after). polished : the polish's result was kept (`PolishSettings.rounds`). timings : seconds per step
         ("mesh", "resolve", "place", "grow", "close", "settle", "finish", "untangle", "polish", "wrap" = all of
@@ -308,7 +308,11 @@ def wrap(
     say("meshing")
     left_out: dict[str, float] = {}
     if isinstance(garment, Pattern):
-        pattern, left_out = _without_slivers(garment, strokes)
+        # Slivers mesh into needle triangles a fraction of a millimetre across that any wrinkle tears (GarmentCode's
+        # sampler cuts trouser cuffs 0.25 mm tall: an edge at 3.6x its length failed the wrap); cloth that narrow
+        # is no part of the garment anyone sees.
+        left_out = slivers_left_out(strokes, garment)
+        pattern = garment.without(left_out) if left_out else garment
         pm = mesh_pattern(pattern, edge_length=p.edge_length_cm)
     elif isinstance(garment, PatternMesh):
         pm = garment
@@ -560,20 +564,6 @@ def wrap(
                 return redone
             raise failure
     return result
-
-
-def _without_slivers(pattern: Pattern, strokes: Strokes) -> tuple[Pattern, dict[str, float]]:
-    """`pattern` without its slivers (`kitsuke.pattern.sliver_pieces`: narrower on average than 5 mm) and their
-    seams, and {name: mean width cm} of those left out. Why: a sliver meshes into needle triangles whose edges are
-    a fraction of a millimetre across, so any wrinkle tears it (GarmentCode's sampler cuts trouser cuffs 0.25 mm
-    tall: an edge at 3.6x its length failed the wrap), and cloth that narrow is no part of the garment anyone sees.
-    A pattern made only of slivers is kept whole (its wrap fails where it tears). InputError where a stroke is
-    drawn on one."""
-    thin = sliver_pieces(pattern)
-    if not thin or len(thin) == len(pattern.pieces):
-        return pattern, {}
-    refuse_strokes_on_slivers(strokes, thin)
-    return pattern.without(thin), thin
 
 
 def _tethers(tracks: list[StrokeTrack], loose: np.ndarray, faces: np.ndarray, reach_m: float) -> Tethers:
