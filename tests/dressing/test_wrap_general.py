@@ -15,10 +15,12 @@ from kitsuke.dressing import (
     WrapParams,
     check_strokes,
     on_body_failures,
+    resolve_strokes,
     target_misses,
     wrap,
 )
 from kitsuke.errors import ComputationError, InputError
+from kitsuke.geometry.surface import Surface
 from kitsuke.metrics import QualityTargets
 from kitsuke.pattern import EdgeRef, Pattern, Piece, Seam, sliver_pieces
 
@@ -207,4 +209,6 @@ def test_a_sliver_is_left_out_of_the_wrap_and_said(sphere, drawn_up):
     # ... and so it is by the check that `kitsuke dress` and `kitsuke strokes check` run before loading the body.
     with pytest.raises(InputError, match="stroke 1 is drawn on piece 'strip', a sliver 0.25 mm wide"):
         check_strokes(on_strip, thin)
+    with pytest.raises(InputError, match="a sliver 0.25 mm wide"):  # `kitsuke strokes check` resolves them
+        resolve_strokes(on_strip, thin, Surface(sphere))
     check_strokes(_upright(_meridian(0.3, 0.16)), thin)  # a stroke on the square is fine
