@@ -145,6 +145,32 @@ def insane(positions, strain_max: float, surface) -> list[str]:
     return out
 
 
+#: A reason's first point "(x, y, z) m": a failure's torn or far cloth, or the worst strained edge.
+POINT = re.compile(r"\((-?\d+\.\d+), (-?\d+\.\d+), (-?\d+\.\d+)\) m")
+#: Places on the body (`BodyRegions.name`) grouped as the summary counts them, by the first word that matches.
+PLACE_GROUPS = (
+    ("under", "armpits"), ("shoulder", "shoulders"), ("arm", "arms"), ("neck", "neck"), ("chest", "chest"),
+    ("waist", "waist"), ("hips", "hips"), ("", "legs"),
+)  # fmt: skip
+
+
+def where_on_body(rows: list[dict], mesh) -> dict[str, int]:
+    """How many of `rows` have the first point their reason gives in each group of places on the body (armpits,
+    shoulders, arms, neck, chest, waist, hips, legs), most first; rows whose reason gives no point are left out."""
+    from kitsuke.body.regions import BodyRegions
+
+    regions = BodyRegions.of(mesh)
+    count: dict[str, int] = {}
+    for r in rows:
+        m = POINT.search(r.get("reason", ""))
+        if m is None:
+            continue
+        name = regions.name(np.array([float(c) for c in m.groups()]))
+        group = next(g for word, g in PLACE_GROUPS if word in name)
+        count[group] = count.get(group, 0) + 1
+    return dict(sorted(count.items(), key=lambda kv: -kv[1]))
+
+
 #: kitsuke.batch statuses -> this benchmark's classes.
 BATCH_STATUS = {"ok": "ok", "out_of_target": "out of target", "refused": "refused", "failed": "failed"}
 
@@ -339,6 +365,9 @@ def main() -> None:
         f"  out of target where the worst strain lies on cloth cut 2 % or more smaller than the body round it: "
         f"{sum(r.get('cut_smaller', False) for r in out)} of {len(out)}"
     )
+    places = where_on_body([r for r in rows if r["status"] in ("failed", "out of target")], body.mesh)
+    if places:
+        print("  where the failures and worst strains lie: " + ", ".join(f"{p} {n}" for p, n in places.items()))
     written = [r for r in rows if "dressed" in r]
     if written:
         how = {h: sum(r["dressed"] == h for r in written) for h in sorted({r["dressed"] for r in written})}

@@ -3,6 +3,8 @@ honest outcome: a result that is not a garment on the body raises ComputationErr
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -102,6 +104,8 @@ def test_cloth_flung_far_from_the_body_is_not_a_garment(drawn_up):
     flung.positions[0] = centre + 0.9 * (flung.positions[0] - centre) / np.linalg.norm(flung.positions[0] - centre)
     failures = on_body_failures(flung, _sphere(0.3))
     assert failures[0].startswith("piece square: cloth 60 cm from the body")  # (and torn, where it was pulled)
+    # where on the body, then where in space (kitsuke.body.regions names the place)
+    assert re.match(r"piece square: cloth 60 cm from the body (at|on|under) the [a-z ]+, at \(.+\) m$", failures[0])
     assert on_body_failures(drawn_up, _sphere(0.3)) == []
 
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..body.regions import BodyRegions
 from ..geometry import TriMesh
 from ..geometry.surface import Surface
 from ..metrics import QualityTargets
@@ -175,7 +176,9 @@ def _piece_of_vertex(garment) -> np.ndarray:
 
 def on_body_failures(garment, body, *, surface: Surface | None = None) -> list[str]:
     """Why `garment` (a DressedGarment) is not a garment on `body` (Body or TriMesh), one line each, naming the
-    piece or stroke; empty when it is one."""
+    piece or stroke, and for torn or far cloth where on the body it is (`kitsuke.body.regions`: "piece
+    right_sleeve_f is torn under the right arm: an edge at 7.5x its length at (-0.25, 1.23, 0.01) m"); empty when
+    it is one."""
     pos = garment.positions
     if not np.isfinite(pos).all():
         bad = ~np.isfinite(pos).all(axis=1)
@@ -186,6 +189,14 @@ def on_body_failures(garment, body, *, surface: Surface | None = None) -> list[s
     surf = surface if surface is not None else Surface(mesh)
     dist = surf.closest(pos).distance
     piece = _piece_of_vertex(garment)
+    regions: list[BodyRegions] = []  # measured only when a line names a place (0.1 s)
+
+    def place(point: np.ndarray) -> tuple[str, str]:
+        """Where `point` is on the body ("under the right arm") and its coordinates ("(x, y, z) m")."""
+        if not regions:
+            regions.append(BodyRegions.of(mesh))
+        return regions[0].name(point), f"({', '.join(f'{c:.2f}' for c in point)}) m"
+
     for k, name in enumerate(garment.piece_names):
         d = dist[piece == k]
         if len(d) and d.min() > OFF_BODY_M:
@@ -196,9 +207,10 @@ def on_body_failures(garment, body, *, surface: Surface | None = None) -> list[s
     far = int(np.argmax(aloft)) if len(dist) else -1
     if far >= 0 and aloft[far] > FAR_CLOTH_M and not out:
         k = piece[far]
+        name, at = place(pos[far])
         out.append(
-            f"piece {garment.piece_names[k] if k >= 0 else '?'}: cloth {100 * dist[far]:.0f} cm from the body at "
-            f"({', '.join(f'{c:.2f}' for c in pos[far])}) m"
+            f"piece {garment.piece_names[k] if k >= 0 else '?'}: cloth {100 * dist[far]:.0f} cm from the body "
+            f"{name}, at {at}"
         )
     m = garment.model
     e = m.edges
@@ -207,9 +219,10 @@ def on_body_failures(garment, body, *, surface: Surface | None = None) -> list[s
     worst = int(np.argmax(ratio)) if len(ratio) else -1
     if worst >= 0 and ratio[worst] > 1.0 + TORN_STRAIN:
         k = piece[e[worst, 0]]
+        name, at = place(pos[e[worst, 0]])
         out.append(
-            f"piece {garment.piece_names[k] if k >= 0 else '?'} is torn: an edge at {ratio[worst]:.1f}x its length"
-            f" at ({', '.join(f'{c:.2f}' for c in pos[e[worst, 0]])}) m"
+            f"piece {garment.piece_names[k] if k >= 0 else '?'} is torn {name}: an edge at {ratio[worst]:.1f}x its"
+            f" length at {at}"
         )
     out += wrong_side(garment, mesh)
     out += sunk_pieces(garment)

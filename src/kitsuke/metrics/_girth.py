@@ -20,6 +20,7 @@ import numpy as np
 
 from ..geometry import TriMesh
 from ..geometry.polygon import convex_hull, polygon_inside
+from ..geometry.section import cut_points, plane_cut
 
 #: A cut of the cloth open by at most this much (metres: a dart's open end, a seam whose two sides were meshed
 #: apart) still counts as a loop; the gap adds nothing to the cloth's length round it.
@@ -58,30 +59,6 @@ class Girth:
             "body_cm": round(100 * self.body_m, 1),
             "short": round(self.short, 4),
         }
-
-
-def _cut(vertices: np.ndarray, faces: np.ndarray, y: float):
-    """The faces crossing the plane Y = y, and for each its two crossing edges: (faces (k,), edges (k, 2, 2) vertex
-    pairs, corner pairs (k, 2, 2) (0-2 within the face), t (k, 2) the crossing's share along each edge)."""
-    s = vertices[faces, 1] - y  # (F, 3)
-    s = np.where(s == 0.0, 1e-12, s)  # a vertex on the plane counts as above it
-    side = s > 0
-    crossing = side.any(axis=1) & ~side.all(axis=1)
-    idx = np.flatnonzero(crossing)
-    differ = side[idx] != np.roll(side[idx], -1, axis=1)  # (k, 3): edge c (corner c to c + 1) crosses; two do
-    first, last = np.argmax(differ, axis=1), 2 - np.argmax(differ[:, ::-1], axis=1)
-    corners = np.stack([np.c_[first, (first + 1) % 3], np.c_[last, (last + 1) % 3]], axis=1)  # (k, 2, 2)
-    a, b = corners[..., 0], corners[..., 1]
-    sa, sb = np.take_along_axis(s[idx], a, axis=1), np.take_along_axis(s[idx], b, axis=1)
-    t = sa / (sa - sb)
-    fv = faces[idx]
-    edges = np.stack([np.take_along_axis(fv, a, axis=1), np.take_along_axis(fv, b, axis=1)], axis=2)
-    return idx, edges, corners, t
-
-
-def _points(vertices: np.ndarray, edges: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """(k, 2, 3) the crossing points on each face's two crossing edges."""
-    return vertices[edges[..., 0]] * (1.0 - t[..., None]) + vertices[edges[..., 1]] * t[..., None]
 
 
 def _loop(edges: np.ndarray, points: np.ndarray, start: int, gap_m: float) -> list[int] | None:
@@ -160,10 +137,10 @@ def worn_loop(
     front-most crossing, the body facing +Z); None where the cut there does not close. positions (V, 3) metres,
     faces (F, 3), rest_corners (F, 3, 2) metres."""
     pos = np.asarray(positions, dtype=np.float64)
-    idx, edges, corners, t = _cut(pos, np.asarray(faces), y)
+    idx, edges, corners, t = plane_cut(pos, np.asarray(faces), y)
     if len(idx) == 0:
         return None
-    worn = _points(pos, edges, t)  # (k, 2, 3)
+    worn = cut_points(pos, edges, t)  # (k, 2, 3)
     middle = worn.mean(axis=1)
     start = int(np.argmax(middle[:, 2]) if point is None else np.argmin(np.linalg.norm(middle - point, axis=1)))
     order = _loop(edges, worn, start, GAP_M)
@@ -182,8 +159,8 @@ def worn_loop(
 
 def body_section(body: TriMesh, y: float) -> np.ndarray:
     """(n, 2) x, z metres: where the body's surface crosses the plane Y = y (two points per crossing face)."""
-    idx, edges, _, t = _cut(body.vertices, body.faces, y)
-    return _points(body.vertices, edges, t).reshape(-1, 3)[:, [0, 2]] if len(idx) else np.zeros((0, 2))
+    idx, edges, _, t = plane_cut(body.vertices, body.faces, y)
+    return cut_points(body.vertices, edges, t).reshape(-1, 3)[:, [0, 2]] if len(idx) else np.zeros((0, 2))
 
 
 def tape_inside(section: np.ndarray, ring: np.ndarray, *, margin_m: float = 0.0) -> float:
