@@ -6,6 +6,7 @@ import pytest
 
 from kitsuke.body import default_body, load_body
 from kitsuke.body.regions import BodyRegions
+from kitsuke.errors import InputError
 
 from ..conftest import DATA
 
@@ -57,3 +58,16 @@ def test_a_body_without_arms_found_names_the_heights_alone():
     armless = BodyRegions(regions.floor_y, regions.height_m, regions.centre, regions.crotch_y, {})
     armpit = regions.arms["left"].start + np.array([0.0, -0.02, 0.0])
     assert armless.name(armpit) == "at the left side of the chest"
+
+
+def test_points_off_the_body_are_named_after_the_nearest_part_and_bad_points_refused():
+    body = default_body()
+    regions = BodyRegions.of(body.mesh)
+    cx, cz = regions.centre
+    below = np.array([cx + 0.1, regions.floor_y - 0.05, cz])  # a train pooled under the floor's height
+    assert regions.name(below) == "at the left ankle"
+    above = np.array([cx, regions.floor_y + regions.height_m + 0.2, cz - 0.2])
+    assert regions.name(above) == "at the back of the neck"
+    for bad in ([np.nan, 1.0, 0.0], [0.0, 1.0]):
+        with pytest.raises(InputError, match="3 finite numbers"):
+            regions.name(np.array(bad))

@@ -4,7 +4,7 @@ body is an armpit, a shoulder or an upper arm (`kitsuke.body.regions`), also for
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -80,9 +80,11 @@ def arm_axes(
         direction = _line(c)
         start = mean + ((c[0] - mean) @ direction) * direction
         axis = ArmAxis(start, direction, float((c[-1] - c[0]) @ direction), 0.0)
-        radius = float(np.median(axis.distance(np.concatenate(points[side][: len(c)]))))
-        hand = float((lowest[side] - start) @ direction)
-        axes[side] = ArmAxis(start, direction, axis.length_m, radius, max(hand, axis.length_m))
+        axes[side] = replace(
+            axis,
+            radius_m=float(np.median(axis.distance(np.concatenate(points[side][: len(c)])))),
+            hand_m=max(float((lowest[side] - start) @ direction), axis.length_m),
+        )
     return axes
 
 

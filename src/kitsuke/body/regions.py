@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
 from ..geometry import TriMesh
 from ..geometry.section import section_parts
 from .arms import ArmAxis, arm_axes
@@ -63,12 +64,15 @@ class BodyRegions:
 
     def name(self, point: np.ndarray) -> str:
         """Where `point` (3,) metres lies, e.g. "under the right arm", "at the front of the waist", "on the left
-        thigh"; a point beside the body is named after the part it is beside."""
+        thigh"; a point beside the body is named after the part it is beside (below the soles: the ankle; above the
+        head: the neck). Raises InputError for anything but 3 finite numbers."""
         p = np.asarray(point, dtype=np.float64)
+        if p.shape != (3,) or not np.isfinite(p).all():
+            raise InputError(f"a point on the body must be 3 finite numbers, got {point!r}")
         arm = self._arm(p)
         if arm:
             return arm
-        share = (p[1] - self.floor_y) / self.height_m
+        share = min(max((p[1] - self.floor_y) / self.height_m, 0.0), 1.0)
         side = "left" if p[0] > self.centre[0] else "right"
         crotch = 0.47 if self.crotch_y is None else (self.crotch_y - self.floor_y) / self.height_m
         if share < crotch:

@@ -14,6 +14,8 @@ Two different questions, with two different answers for a user:
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from ..body.regions import BodyRegions
@@ -177,7 +179,7 @@ def _piece_of_vertex(garment) -> np.ndarray:
 def on_body_failures(garment, body, *, surface: Surface | None = None) -> list[str]:
     """Why `garment` (a DressedGarment) is not a garment on `body` (Body or TriMesh), one line each, naming the
     piece or stroke, and for torn or far cloth where on the body it is (`kitsuke.body.regions`: "piece
-    right_sleeve_f is torn under the right arm: an edge at 7.5x its length at (-0.25, 1.23, 0.01) m"); empty when
+    right_sleeve_f is torn at the right shoulder: an edge at 7.5x its length at (-0.25, 1.33, 0.01) m"); empty when
     it is one."""
     pos = garment.positions
     if not np.isfinite(pos).all():
@@ -189,13 +191,11 @@ def on_body_failures(garment, body, *, surface: Surface | None = None) -> list[s
     surf = surface if surface is not None else Surface(mesh)
     dist = surf.closest(pos).distance
     piece = _piece_of_vertex(garment)
-    regions: list[BodyRegions] = []  # measured only when a line names a place (0.1 s)
+    regions = functools.cache(lambda: BodyRegions.of(mesh))  # measured only when a line names a place (0.1 s)
 
     def place(point: np.ndarray) -> tuple[str, str]:
         """Where `point` is on the body ("under the right arm") and its coordinates ("(x, y, z) m")."""
-        if not regions:
-            regions.append(BodyRegions.of(mesh))
-        return regions[0].name(point), f"({', '.join(f'{c:.2f}' for c in point)}) m"
+        return regions().name(point), f"({', '.join(f'{c:.2f}' for c in point)}) m"
 
     for k, name in enumerate(garment.piece_names):
         d = dist[piece == k]
