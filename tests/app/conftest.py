@@ -58,7 +58,12 @@ class AppPage:
         self.page.wait_for_timeout(1500)  # the first frames, and the camera's first report
         close = self.page.locator("button.mantine-Notification-closeButton")
         if close.count():  # viser's "software WebGL" notice swallows clicks under it
-            close.first.click()
+            from playwright.sync_api import TimeoutError as PlaywrightTimeoutError
+
+            try:
+                close.first.click(timeout=3000)
+            except PlaywrightTimeoutError:  # it closed itself meanwhile (seen on a loaded machine: detached, retried)
+                pass
 
     def until(self, condition, what: str, timeout: float = 20.0) -> None:  # noqa: ANN001
         """Wait (polling the app's own state) until `condition()` holds: the page's events reach the server on its
