@@ -143,10 +143,10 @@ def untangle(
             _smooth(model, state.positions, grow_region(model.faces, seed, 1) & ~pinned, SMOOTH_PASSES)
         region = state.holding(~free)
         if tethers is None or not len(tethers):
-            relax(local, region, collider, iterations=iterations)
+            relax(local, region, collider, iterations=iterations, around_free=True)
         else:
             for chunk in np.array_split(np.arange(iterations), TETHER_CHUNKS):
-                relax(local, region, collider, iterations=len(chunk))
+                relax(local, region, collider, iterations=len(chunk), around_free=True)
                 for _ in range(TETHER_PASSES):  # points sharing a vertex move each other: a few passes
                     if not tethers.project(state.positions, free):
                         break

@@ -309,7 +309,9 @@ def rewrap(
             ]
         )
 
+    timings.update(log.timings)
     if p.polish_rounds:
+        t3 = time.perf_counter()
         # The wrap's last step, without refinement (the garment keeps its vertices); pins and held strokes held,
         # and not kept if it takes a stroke farther from its line.
         kept, polished = polish_step(
@@ -323,6 +325,7 @@ def rewrap(
         )
         if kept:
             state = polished.state
+        timings["polishing"] = time.perf_counter() - t3
     state.positions[pinned] = g.positions[pinned]  # exactly still
     timings["relax"] = time.perf_counter() - t2
     timings["rewrap"] = time.perf_counter() - t0
