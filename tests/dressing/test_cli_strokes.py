@@ -3,11 +3,13 @@ written, `--keep-failed`)."""
 
 from __future__ import annotations
 
+import importlib
 import json
 
 import pytest
 
 from kitsuke.dressing import read_strokes
+from kitsuke.errors import ComputationError
 
 from ..conftest import DATA
 
@@ -43,7 +45,7 @@ def test_suggest_refuses_a_pattern_without_placement_in_one_line(run_cli, tmp_pa
 
 @pytest.mark.slow
 def test_dress_exits_1_on_strokes_no_garment_can_meet_and_keeps_the_result_only_when_asked(
-    run_cli, suggested, tmp_path
+    run_cli, suggested, tmp_path, monkeypatch
 ):
     # The front torso's stroke drawn on the back of the body as well: one piece on both sides of the torso.
     doc = json.loads(suggested.read_text())
@@ -54,14 +56,35 @@ def test_dress_exits_1_on_strokes_no_garment_can_meet_and_keeps_the_result_only_
     bad.write_text(json.dumps(doc))
     out, report = tmp_path / "shirt.glb", tmp_path / "shirt.json"
     args = ("dress", "--body", MEAN_ALL, "--pattern", SHIRT, "--strokes", bad, "-o", out, "--report", report)
+    # The failing wrap runs once (it tries grown, laid and sewn: half a minute); the second command meets its error.
+    wrap_module = importlib.import_module("kitsuke.dressing.wrap")  # the module, not the function of its name
+    real, failures = wrap_module.wrap, []
+
+    def recording(*a, **k):  # noqa: ANN002, ANN003
+        try:
+            return real(*a, **k)
+        except ComputationError as e:
+            failures.append(e)
+            raise
+
+    monkeypatch.setattr(wrap_module, "wrap", recording)
+    r = run_cli(*args, "--no-polish", "--keep-failed")
+    assert r.code == 1 and failures[-1].result is not None  # the last: the relay's tries call wrap too
+    said = r.err.strip().splitlines()
+    assert said[-1].startswith("kitsuke: failed: wrap") and "kept the failed result" in said[0] and len(said) == 2
+    assert (tmp_path / "shirt.failed.glb").exists() and (tmp_path / "shirt.failed.json").exists()
+    assert not out.exists() and not report.exists()
+    for kept in tmp_path.glob("shirt.failed.*"):
+        kept.unlink()
+
+    def failing(*a, **k):  # noqa: ANN002, ANN003
+        raise failures[-1]
+
+    monkeypatch.setattr(wrap_module, "wrap", failing)
     r = run_cli(*args, "--no-polish")
     assert r.code == 1
     assert r.err.startswith("kitsuke: failed: wrap") and len(r.err.strip().splitlines()) == 1
-    assert not out.exists() and not report.exists()
-    r = run_cli(*args, "--no-polish", "--keep-failed")
-    assert r.code == 1
-    assert (tmp_path / "shirt.failed.glb").exists() and (tmp_path / "shirt.failed.json").exists()
-    assert not out.exists() and not report.exists()
+    assert not any(tmp_path.glob("shirt*"))  # nothing written without --keep-failed
 
 
 def test_dress_on_suggested_strokes_reports_what_it_misses(run_cli, suggested, tmp_path):

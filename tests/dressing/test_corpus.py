@@ -20,11 +20,12 @@ from kitsuke.pattern import load_pattern
 from ..conftest import DATA
 
 CORPUS = sorted((DATA / "pattern" / "corpus").glob("*_specification.json"))
-#: How many of the nine meet every corpus target at least (measured 2026-11-27: 3, the flared skirt gc_s7741_0009,
-#: draped (max strain 4.9 %), the cuffed trousers gc_s101_0006, their legs gathered into the cuffs (4.5 %, mean
-#: 0.8 %; out of target sewn ungathered), and the shirt gc_s2718_0026, torn round the arm when grown, dressed with
-#: every piece laid (4.5 %); which others moves between machines and versions, as the wrap is sensitive to rounding).
-AT_LEAST_WITHIN_TARGETS = 3
+#: Designs that meet every corpus target, each by a mechanism of its own (measured 2026-11-27 and 2026-11-28 on two
+#: machines): the flared skirt gc_s7741_0009, draped (max strain 4.9 %); the cuffed trousers gc_s101_0006, their
+#: legs gathered into the cuffs (4.5 %, mean 0.8 %; out of target sewn ungathered); and the shirt gc_s2718_0026,
+#: torn round the arm when grown, dressed with every piece laid (4.5 %). Which of the others meet them moves
+#: between machines and versions, as the wrap is sensitive to rounding: they are held to honest outcomes only.
+WITHIN_TARGETS = {"gc_s7741_0009", "gc_s101_0006", "gc_s2718_0026"}
 
 
 @pytest.fixture(scope="module")
@@ -60,6 +61,13 @@ def _outcome(body, collider, surface, path) -> str:
 
 
 @pytest.mark.slow
-def test_corpus_designs_dress_or_fail_honestly(mean_all):
-    outcomes = {p.stem: _outcome(*mean_all, p) for p in CORPUS}
-    assert sum(o == "within" for o in outcomes.values()) >= AT_LEAST_WITHIN_TARGETS, outcomes
+@pytest.mark.parametrize("path", CORPUS, ids=lambda p: p.stem.replace("_specification", ""))
+def test_corpus_design_dresses_or_fails_honestly(mean_all, path):
+    """One test per design, so that a parallel run spreads them (the slowest takes about a minute)."""
+    outcome = _outcome(*mean_all, path)
+    if path.stem.replace("_specification", "") in WITHIN_TARGETS:
+        assert outcome == "within"
+
+
+def test_the_designs_said_to_meet_the_targets_are_in_the_corpus():
+    assert WITHIN_TARGETS <= {p.stem.replace("_specification", "") for p in CORPUS}
