@@ -217,11 +217,9 @@ def test_a_garment_that_fails_grown_and_laid_is_written_with_its_seams_sewn():
     fails grown (a stroke's cloth 7 cm off) and laid; the last try sews its seams (`kitsuke.cloth.sew`) and the
     garment is on the body: written, not refused. (Strokes the settle moved 5-8 cm let go, as in the first test.)"""
     body, collider, surface, pattern, strokes = _on_mean_all(SEWN_TOP, raise_=False)
-    unsewn = WrapParams().changed({"close.sew_on_failure": False, **LET_GO_AT_5_CM})
-    with pytest.raises(ComputationError) as first:
-        wrap(body, pattern, strokes, collider=collider, params=unsewn)
+    # (The relay sews only after the grown and the laid tries failed: sewn and nothing laid says both did.)
     garment = wrap(body, pattern, strokes, collider=collider, params=WrapParams().changed(LET_GO_AT_5_CM))
-    assert garment.sewn and garment.laid == [] and garment.redone_after == first.value.message
+    assert garment.sewn and garment.laid == [] and garment.redone_after.startswith("not a garment on the body")
     assert on_body_failures(garment, body, surface=surface) == []
     assert np.isfinite(garment.positions).all() and garment.report.strain_max < 1.0
     assert garment.report.penetration_count == 0
