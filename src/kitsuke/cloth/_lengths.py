@@ -232,3 +232,18 @@ def _bounded(pos: np.ndarray, origin: np.ndarray) -> bool:
     d = pos - origin
     worst = float(np.einsum("ij,ij->i", d, d).max(initial=0.0))
     return bool(np.isfinite(worst) and worst <= RUNAWAY_M * RUNAWAY_M)
+
+
+def compile_lengths() -> None:
+    """Compile the length sweeps' and the tethers' kernels (`project_lengths`, `project_band`, `project_tethers`
+    with and without stamps), or load them from numba's cache, on a small stretched sheet with one tether: the
+    argument types the wrap passes them. A cold `kitsuke demo` compiled them in its own process for 2.3 s after
+    its relaxation's kernels; `kitsuke.cloth.precompile_in_background` runs this in another process instead."""
+    from ._shapes import grid_sheet
+
+    uv, faces = grid_sheet(3, 3, 0.02)
+    model = ClothModel.from_flat(faces, uv)
+    tethers = Tethers.from_polylines([(np.array([0]), np.full((1, 3), 1 / 3), np.zeros((2, 3)))], faces, 0.01)
+    for band in (0.0, 0.045):  # a restoration, then a strain limit (stamped sweeps)
+        state = ClothState.new(model, np.c_[1.1 * uv, np.zeros(len(uv))])
+        restore_lengths(model, state, sweeps=2, tethers=tethers, band=band)
