@@ -617,16 +617,10 @@ def _polish_passes(
         return refined_tracks[id(rp)]
 
     def residual_of(positions: np.ndarray, rp: RefinedPolish | None = None) -> np.ndarray:
-        """The held strokes' residuals (metres): a loose stroke is reported as not held already. Judged by the loose
-        ones too, the try with every stroke let go kept no polish (GarmentCode's top over a pencil skirt in
-        tests/data, its strokes where the skirt cannot fit: 76 % max strain held; let go and polished 7.1 %, the
-        strokes 46 mm off; `test_fit_height`)."""
         if rp is None or not rp.levels:
-            faces, moved = out.model.faces, out.tracks
-        else:
-            ordered, moved = on_refined(rp)
-            faces = ordered.model.faces
-        return np.array([tr.residual_m(positions, faces) for tr, far in zip(moved, loose, strict=True) if not far])
+            return np.array([tr.residual_m(positions, out.model.faces) for tr in out.tracks])
+        ordered, moved = on_refined(rp)
+        return np.array([tr.residual_m(positions, ordered.model.faces) for tr in moved])
 
     settings = p.polish_settings()
     passes = 0
