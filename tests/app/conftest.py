@@ -15,8 +15,8 @@ FLAGS = [
     "--disable-background-networking", "--disable-component-update", "--disable-sync",
 ]  # fmt: skip
 #: The tab's size: small, as Chromium renders WebGL in software here and its pixels cost the test machine's cores
-#: (the browser wrap test alone: 77 s at 1280 x 800, 57 s at 1120 x 700; at 960 x 600 the control panel covers
-#: the board's right end). The README's pictures are taken at 1280 x 800 (KITSUKE_APP_SCREENSHOTS set).
+#: (the browser wrap test alone: 77 s at 1280 x 800, 57 s at 1120 x 700). The README's pictures are taken at
+#: 1280 x 800 (KITSUKE_APP_SCREENSHOTS set).
 VIEWPORT = (
     {"width": 1280, "height": 800} if os.environ.get("KITSUKE_APP_SCREENSHOTS") else {"width": 1120, "height": 700}
 )
@@ -45,15 +45,17 @@ def browser():
 class AppPage:
     """A started app, one browser tab on it, and helpers to point at scene positions."""
 
-    def __init__(self, app, page) -> None:
+    def __init__(self, app, page, view=None) -> None:  # noqa: ANN001
         self.app = app
         self.page = page
+        self._view = view
         self.requests: list[str] = []
         page.on("request", lambda r: self.requests.append(r.url))
 
     @property
     def view(self):
-        return next(iter(self.app.views.values()))
+        """The tab's ClientView (the app's first, unless given)."""
+        return self._view or next(iter(self.app.views.values()))
 
     def wait_connected(self, timeout: float = 30.0) -> None:
         t0 = time.monotonic()
@@ -106,7 +108,7 @@ class AppPage:
         rel = np.atleast_2d(points) - eye
         x, y, z = rel @ r, rel @ u, rel @ f
         t = np.tan(cam.fov / 2)
-        w, h = VIEWPORT["width"], VIEWPORT["height"]
+        w, h = self.page.viewport_size["width"], self.page.viewport_size["height"]
         ndc_x = x / (z * t * w / h)
         ndc_y = y / (z * t)
         return np.c_[(ndc_x + 1) / 2 * w, (1 - ndc_y) / 2 * h]

@@ -344,6 +344,39 @@ def test_each_tab_is_its_own_session(app_page, browser):
     other.close()
 
 
+def test_a_small_window_shows_the_body_and_the_board_beside_the_panel(app_page, browser):
+    """In a 960 x 600 tab the camera frames the body and every pattern piece left of the control panel (a fixed
+    camera put the board's right end under it); after the user pans, "Fit view" frames them again."""
+    from .conftest import AppPage
+
+    page = browser.new_page(viewport={"width": 960, "height": 600})
+    page.goto(app_page.app.url)
+    app_page.until(lambda: len(app_page.app.views) == 2, "the small tab never connected")
+    view = list(app_page.app.views.values())[-1]
+    small = AppPage(app_page.app, page, view)
+    app_page.until(lambda: view._framed, "the small tab's camera never reported its size")
+    fit = page.get_by_role("button", name="Fit view")
+    panel_left = fit.bounding_box()["x"] - 16  # the button's inset in the panel
+
+    def scene_on_screen() -> np.ndarray:
+        mesh = view.session.body.mesh
+        corners = [mesh.vertices.min(axis=0), mesh.vertices.max(axis=0), *view.board.bounds()]
+        box = np.array(corners)
+        low, high = box.min(axis=0), box.max(axis=0)
+        front = np.array([[x, y, high[2]] for x in (low[0], high[0]) for y in (low[1], high[1])])
+        return small.screen(front)
+
+    app_page.until(lambda: scene_on_screen()[:, 0].max() < panel_left, "the scene is not left of the panel")
+    px = scene_on_screen()
+    assert px.min() > 0 and px[:, 1].max() < 600
+    assert np.ptp(px[:, 0]) > 0.8 * panel_left or np.ptp(px[:, 1]) > 0.8 * 600  # as large as fits
+    view.client.camera.position = np.asarray(view.client.camera.position) - [1.0, 0.0, 0.0]  # the user pans
+    app_page.until(lambda: scene_on_screen()[:, 0].max() > panel_left, "the pan never moved the scene under the panel")
+    fit.click()
+    app_page.until(lambda: scene_on_screen()[:, 0].max() < panel_left, "Fit view never framed the scene again")
+    page.close()
+
+
 def test_cli_app_refuses_bad_arguments(run_cli, tmp_path):
     r = run_cli("app", "--port", "70000", "--no-browser")
     assert r.code == 2 and "--port" in r.err

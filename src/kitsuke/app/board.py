@@ -22,11 +22,13 @@ GAP_CM = 8.0
 @dataclass(frozen=True)
 class PiecePlace:
     """Where one piece lies on the board. origin : (2,) board metres (x, y) of the piece's lower-left bound
-    corner. low : (2,) the piece's lower-left bound, cm. width_cm : its width, cm. flipped : shown mirrored."""
+    corner. low : (2,) the piece's lower-left bound, cm. width_cm, height_cm : its size, cm. flipped : shown
+    mirrored."""
 
     origin: np.ndarray
     low: np.ndarray
     width_cm: float
+    height_cm: float
     flipped: bool
 
 
@@ -49,10 +51,23 @@ class BoardLayout:
             w, h = (high - low) * s
             if x > x0 and x + w > x0 + width_m:
                 x, y, row_h = x0, y - row_h - GAP_CM * s, 0.0
-            places[piece.name] = PiecePlace(np.array([x, y - h]), low.copy(), float(high[0] - low[0]), piece.flipped)
+            size = high - low
+            places[piece.name] = PiecePlace(
+                np.array([x, y - h]), low.copy(), float(size[0]), float(size[1]), piece.flipped
+            )
             x += w + GAP_CM * s
             row_h = max(row_h, h)
         return BoardLayout(places, s, z)
+
+    def bounds(self) -> np.ndarray | None:
+        """(2, 3) board metres: the lowest and highest corner of the box round every piece; None without pieces."""
+        if not self.places:
+            return None
+        corners = [
+            p.origin + np.array([p.width_cm, p.height_cm]) * s for p in self.places.values() for s in (0.0, self.scale)
+        ]
+        xy = np.array(corners)
+        return np.c_[np.array([xy.min(axis=0), xy.max(axis=0)]), [self.z, self.z]]
 
     def to_board(self, piece: str, points_cm: np.ndarray) -> np.ndarray:
         """(n, 3) board metres of (n, 2) piece-local centimetres."""

@@ -24,6 +24,7 @@ from .drag_history import DragHistory
 from .dragger import Dragger
 from .editor import PatternEditor
 from .editor_view import EditorTools
+from .framing import frame
 from .session import DressingSession, pair_color
 from .worker import Cancelled
 
@@ -69,6 +70,8 @@ class ClientView:
         self._build_scene()
         self._redraw_strokes()
         client.scene.on_click()(self.tools.scene_clicked)  # corners of a piece being drawn (once: scenes are rebuilt)
+        self._framed = False
+        client.camera.on_update(self._first_camera_report)
 
     @property
     def editor(self) -> PatternEditor:
@@ -76,6 +79,27 @@ class ClientView:
         return self.tools.editor
 
     # -- scene ------------------------------------------------------------------------------------------------
+    def _first_camera_report(self, camera) -> None:  # noqa: ANN001 - a viser CameraHandle
+        """The tab's size is known from its camera's first report: frame the scene in it, once (a later resize or
+        orbit is the user's; "Fit view" frames again)."""
+        if not self._framed:
+            self._framed = True
+            self.fit_view()
+
+    def fit_view(self) -> None:
+        """Frame the body and the pattern board whole in the canvas left of the control panel (`framing.frame`)."""
+        cam = self.client.camera
+        mesh = self.session.body.mesh
+        boxes = [mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)]
+        board = self.board.bounds()
+        if board is not None:
+            boxes += list(board)
+        corners = np.array(boxes)
+        f = frame(corners.min(axis=0), corners.max(axis=0), cam.fov, cam.image_width, cam.image_height)
+        with self.client.atomic():
+            cam.position = tuple(f.position)
+            cam.look_at = tuple(f.look_at)
+
     def _build_scene(self) -> None:
         from ..pattern import mesh_pattern
 
@@ -276,6 +300,9 @@ class ClientView:
             self.flip_choice = gui.add_dropdown("Piece", pieces, initial_value=pieces[0])
             gui.add_button("Turn piece over").on_click(
                 lambda _: self.tools.apply(lambda: self.editor.flip(self.flip_choice.value))
+            )
+            gui.add_button("Fit view", hint="the body and the pattern whole, beside this panel").on_click(
+                lambda _: self.fit_view()
             )
         with gui.add_folder("Edit the pattern", expand_by_default=False):
             self.tools.build_panel(gui)
