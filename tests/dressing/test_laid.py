@@ -6,6 +6,7 @@ arm is worn when every piece is laid."""
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import json
 import re
 import zlib
@@ -162,6 +163,40 @@ def test_the_wrap_lays_what_growth_took_to_the_wrong_side(skirt_on_back_stroke):
     assert wrong_side_pieces(g, body.mesh) == [] and on_body_failures(g, body, surface=surface) == []
     assert "skirt_back" not in g.laid
     assert ("first try" in g.timings) == bool(g.laid)
+
+
+def test_the_relay_makes_at_most_three_tries_a_chain(skirt_on_back_stroke, monkeypatch):
+    """A garment whose every try puts another piece on the wrong side: the relay lays the wrong pieces once, then
+    every piece, and does the same sewn; six tries in all, then the first try's failure (before, the relay laid one
+    more piece a try, eight tries for a top over a tiered skirt)."""
+    wrap_module = importlib.import_module("kitsuke.dressing.wrap")  # the package's `wrap` is the function
+    body, collider, _, pattern, strokes = skirt_on_back_stroke
+    first = wrap(
+        body, pattern, strokes, collider=collider, params=WrapParams().changed({"grow.relay": False}), check=False
+    )
+    names = iter(first.piece_names * 4)
+    tries, said = [], []
+
+    def dress(prep, p, report, say, t0, timings):
+        tries.append((p.grow.laid, p.close.sew_frames > 0))
+        return dataclasses.replace(first, laid=[] if p.grow.laid != ("*",) else list(first.piece_names))
+
+    monkeypatch.setattr(wrap_module, "_dress", dress)
+    monkeypatch.setattr(wrap_module, "_failure", lambda g, prep: ComputationError("wrap", "torn"))
+    monkeypatch.setattr(wrap_module, "wrong_side_pieces", lambda g, mesh: [(first.piece_names.index(next(names)), "")])
+    with pytest.raises(ComputationError, match="torn"):
+        wrap(body, pattern, strokes, collider=collider, progress=said.append)
+    wrong = [laid for laid, _ in tries[1:2] + tries[4:5]]
+    assert [sewn for _, sewn in tries] == [False] * 3 + [True] * 3
+    assert [laid for laid, _ in tries] == [(), *wrong[:1], ("*",), (), *wrong[1:], ("*",)]
+    assert all(len(laid) == 1 for laid in wrong)
+    assert [s for s in said if s.startswith(("laying", "sewing"))] == [
+        f"laying {wrong[0][0]} at the placement",
+        "laying every piece at the placement",
+        "sewing the seams",
+        f"laying {wrong[1][0]} at the placement",
+        "laying every piece at the placement",
+    ]
 
 
 def test_laid_takes_every_piece():

@@ -15,8 +15,8 @@ Steps (the paper's, with the interpretations of SPEC §4.2):
    The stroke triangles stay pinned while the garment grows. Pieces named in `grow.laid` are not grown but laid
    where the pattern's placement puts them (`_laid`; "*": every placed piece); a wrap whose result has a piece
    without strokes on the wrong side of the body (`outcome.wrong_side_pieces`) lays those pieces and dresses once
-   more, and one that fails otherwise (torn round a limb, off the body) dresses once more with every placed piece
-   laid (`grow.relay`).
+   more, and one that fails otherwise (torn round a limb, off the body), or fails again, dresses once more with
+   every placed piece laid (`grow.relay`; at most two such tries after a failed one).
 3. **Seams**: the garment mesh shares the vertices of every seam from the start (`_weld`; corners where two seams
    of one piece meet are repaired first, `repair_corners`), so where two grown regions meet at a seam the
    triangles between them are stretched. A closing relaxation without gravity (`_solve.GlobalRelax`: a global
@@ -302,8 +302,62 @@ def wrap(
         raise InputError("no strokes: the wrap needs at least one stroke pair", strokes.source or None)
     if strokes.target != "body":
         raise InputError("wrap dresses a body: these strokes target a garment (use a re-wrap)", strokes.source or None)
-    timings: dict[str, float] = {}
     say = progress or (lambda _stage: None)
+    t0 = time.perf_counter()
+    prep = _prepare(body, garment, strokes, pattern, p, collider, say)
+    first = _dress(prep, p, report, say, t0, dict(prep.timings))
+    if not check:
+        return first
+    failure = _failure(first, prep)
+    if failure is None:
+        return first
+    # The relay (`GrowSettings.relay`, `CloseSettings.sew_on_failure`): chains of at most three tries, which bounds
+    # its time (a top over a tiered skirt laid piece by piece took eight tries): the garment as grown (the first
+    # try) or sewn, then the pieces growth took to the wrong side laid at their placement, then every piece laid.
+    chains: list[tuple[WrapParams, DressedGarment | None]] = [(p, first)]
+    if p.close.sew_on_failure and not p.close.sew_frames:
+        chains.append((p.changed({"close.sew_frames": SEW_FRAMES, "close.sew_on_failure": False}), None))
+    for q, tried in chains:
+        if tried is None:
+            say("sewing the seams")
+            t_try = time.perf_counter()
+            tried = _try(prep, q, report, say, t_try)
+        for every in (False, True, None):
+            if tried is None:  # a stage of that try went non-finite: its chain ends
+                break
+            if tried is not first and _failure(tried, prep) is None:
+                tried.timings["first try"] = t_try - t0  # the earlier tries' time
+                tried.redone_after = failure.message
+                return tried
+            relay = None if every is None else _relayed(q, tried, prep.mesh, every)
+            if relay is None:
+                break
+            q, what = relay
+            say(what)
+            t_try = time.perf_counter()
+            tried = _try(prep, q, report, say, t_try)
+    first.timings["wrap"] = time.perf_counter() - t0  # every try
+    raise failure
+
+
+@dataclass
+class _Prepared:
+    """What every try of one wrap shares: the body, the meshed garment and the strokes resolved on the body."""
+
+    body: object
+    mesh: TriMesh
+    pm: PatternMesh
+    pattern: Pattern | None
+    strokes: Strokes
+    collider: BodyCollider
+    surface: object
+    left_out: dict[str, float]
+    timings: dict[str, float]
+
+
+def _prepare(body, garment, strokes: Strokes, pattern, p: WrapParams, collider, say) -> _Prepared:
+    """Mesh the garment (a Pattern, slivers left out) and put its strokes on the body; see `wrap`."""
+    timings: dict[str, float] = {}
     t0 = time.perf_counter()
     say("meshing")
     left_out: dict[str, float] = {}
@@ -340,8 +394,46 @@ def wrap(
                 )
     t2 = time.perf_counter()
     timings["resolve"] = t2 - t1
-    say("placing the pieces")
+    return _Prepared(body, mesh, pm, pattern, strokes, collider, surface, left_out, timings)
 
+
+def _failure(garment: DressedGarment, prep: _Prepared) -> ComputationError | None:
+    """The wrap's failure when `garment` is not a garment on the body (`outcome.on_body_failures`), else None."""
+    bad = on_body_failures(garment, prep.body, surface=prep.surface)
+    if not bad:
+        return None
+    more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
+    return ComputationError("wrap", f"not a garment on the body: {bad[0]}{more}", result=garment)
+
+
+def _relayed(p: WrapParams, failed: DressedGarment, mesh: TriMesh, every: bool) -> tuple[WrapParams, str] | None:
+    """The relay's next try after `failed`, dressed with `p`: its settings and what it does, one line; None when
+    the relay is off or has no piece left to lay. The pieces without strokes that growth took to the wrong side
+    of the body (`outcome.wrong_side_pieces`) are laid at their placement; with none (cloth torn round a limb, a
+    piece off the body), or `every`, every placed piece is laid."""
+    pm = failed.pattern_mesh
+    if not p.grow.relay or "*" in p.grow.laid or not pm.placed.any():
+        return None
+    wrong = [] if every else [pm.piece_names[k] for k, _ in wrong_side_pieces(failed, mesh)]
+    wrong = [name for name in wrong if name not in failed.laid]
+    laid = tuple(p.grow.laid) + tuple(wrong) if wrong else ("*",)
+    return p.changed({"grow.laid": laid}), f"laying {', '.join(wrong) or 'every piece'} at the placement"
+
+
+def _try(prep: _Prepared, p: WrapParams, report: bool, say, t0: float) -> DressedGarment | None:
+    """One more try of the relay; None when a stage of it went non-finite."""
+    try:
+        return _dress(prep, p, report, say, t0, {})
+    except ComputationError:
+        return None
+
+
+def _dress(prep: _Prepared, p: WrapParams, report: bool, say, t0: float, timings: dict[str, float]) -> DressedGarment:
+    """One try of the wrap (steps 1-7, the report), not checked; `t0` its start (timings["wrap"] from it)."""
+    body, mesh, pm, pattern, strokes = prep.body, prep.mesh, prep.pm, prep.pattern, prep.strokes
+    collider, surface, left_out = prep.collider, prep.surface, prep.left_out
+    say("placing the pieces")
+    t2 = time.perf_counter()
     welded = weld(pm)
     shaping = collider  # growth, close and mend run against the body with its leg gap filled, for a skirt
     hang = p.grow.hang
@@ -525,44 +617,6 @@ def wrap(
             if result.girth is not None and result.girth.short >= SHORT_SAID:
                 result.fits_higher_m = fitting_lift(state.positions, out_model.faces, out_model.rest_corners, surface)
         timings["report"] = time.perf_counter() - t6
-    if check:
-        bad = on_body_failures(result, body, surface=surface)
-        if bad:
-            more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
-            failure = ComputationError("wrap", f"not a garment on the body: {bad[0]}{more}", result=result)
-            wrong = [pm.piece_names[k] for k, _ in wrong_side_pieces(result, mesh) if k not in laid]
-            tries = []
-            if p.grow.relay and (wrong or not (every or not pm.placed.any())):
-                # Pieces growth took to the wrong side are laid at their placement; a failure without such a piece
-                # (cloth torn round a limb, a piece off the body) is dressed once more with every placed piece
-                # laid. That try sews nothing itself: the sewn try below comes after it.
-                again_laid = tuple(p.grow.laid) + tuple(wrong) if wrong else ("*",)
-                relay = p.changed({"grow.laid": again_laid, "close.sew_on_failure": False})
-                tries.append((f"laying {', '.join(wrong) or 'every piece'} at the placement", relay))
-            if p.close.sew_on_failure and not p.close.sew_frames:
-                # The last resort: the same garment with its seams sewn (and, failing that, its own relay, sewn).
-                sewn = p.changed({"close.sew_frames": SEW_FRAMES, "close.sew_on_failure": False})
-                tries.append(("sewing the seams", sewn))
-            for what, again in tries:
-                say(what)
-                try:
-                    redone = wrap(
-                        body,
-                        garment,
-                        strokes,
-                        pattern=pattern,
-                        params=again,
-                        collider=collider,
-                        report=report,
-                        progress=progress,
-                    )
-                except ComputationError as e:
-                    timings["wrap"] += e.result.timings.get("wrap", 0.0) if e.result is not None else 0.0
-                    continue
-                redone.timings["first try"] = timings["wrap"] + redone.timings.get("first try", 0.0)  # earlier tries
-                redone.redone_after = failure.message  # the first try's (an inner relay set its own)
-                return redone
-            raise failure
     return result
 
 

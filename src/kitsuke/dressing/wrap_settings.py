@@ -91,9 +91,10 @@ class GrowSettings:
         were; a piece's stroke triangles stay on its strokes) instead of grown (`_laid`); "*": every piece with a
         placement. Pieces without a placement are grown.
     relay : when growth takes a piece without strokes to the wrong side of the body (`outcome.wrong_side_pieces`),
-        dress once more with it laid (added to `laid`), while that finds new pieces; when the wrap fails
-        otherwise (`outcome.on_body_failures`: torn cloth, a piece off the body), dress once more with every
-        placed piece laid ("*").
+        dress once more with it laid (added to `laid`); when the wrap fails otherwise (`outcome.on_body_failures`:
+        torn cloth, a piece off the body), or that try fails too, dress once more with every placed piece laid
+        ("*"). At most two such tries follow a failed one, so the relay's time is bounded (with the sewn try of
+        `CloseSettings.sew_on_failure` and its own two: six tries at most).
     """
 
     lift_m: float = 0.004
