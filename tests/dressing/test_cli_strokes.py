@@ -97,11 +97,14 @@ def test_dress_on_suggested_strokes_reports_what_it_misses(run_cli, suggested, t
     assert ("all quality targets met" in said) == (summary["targets_missed"] == [])
 
 
-@pytest.mark.parametrize("share", ["nan", "-0.1", "1.5"])
-def test_suggest_refuses_a_bad_min_area_naming_the_flag(run_cli, tmp_path, share):
+@pytest.mark.parametrize(
+    ("flag", "value"),
+    [("--min-area", v) for v in ("nan", "-0.1", "1.5")] + [("--min-area-cm2", v) for v in ("nan", "-5")],
+)
+def test_suggest_refuses_a_bad_min_area_naming_the_flag(run_cli, tmp_path, flag, value):
     out = tmp_path / "s.json"
-    r = run_cli("strokes", "suggest", "--body", MEAN_ALL, "--pattern", SHIRT, "-o", out, "--min-area", share)
-    assert r.code == 2 and "--min-area" in r.err and len(r.err.strip().splitlines()) == 1 and not out.exists()
+    r = run_cli("strokes", "suggest", "--body", MEAN_ALL, "--pattern", SHIRT, "-o", out, flag, value)
+    assert r.code == 2 and f"{flag} must" in r.err and len(r.err.strip().splitlines()) == 1 and not out.exists()
 
 
 @pytest.mark.slow

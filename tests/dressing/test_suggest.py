@@ -134,7 +134,7 @@ def test_when_no_large_piece_reaches_the_body_the_smaller_ones_get_strokes(mean_
     waistband, under half the largest bodice piece, gets none), and the skirt is drawn in below them."""
     skirt = ["skirt_front", "skirt_back"]
     pattern = _laid_out(load_pattern(CORPUS / "gc_s101_0009_specification.json"), skirt, 1.5)
-    params = SuggestParams(settle=False, min_area_share=0.5)
+    params = SuggestParams(settle=False, min_area_share=0.5, min_area_cm2=np.inf)
     strokes = suggest_strokes(mean_all, pattern, params=params, surface=mean_surface)
     check_strokes(strokes, pattern)
     by_piece = {p.pattern.piece: p.body.points for p in strokes.pairs}
@@ -142,6 +142,25 @@ def test_when_no_large_piece_reaches_the_body_the_smaller_ones_get_strokes(mean_
     assert torso <= set(by_piece) and not {"wb_front", "wb_back"} & set(by_piece)
     assert set(skirt) <= set(by_piece)
     assert max(by_piece[name][:, 1].max() for name in skirt) < min(by_piece[name][:, 1].min() for name in torso)
+
+
+def test_a_bodice_beside_a_much_larger_skirt_gets_strokes_of_its_own(mean_all, mean_surface):
+    """GarmentCode's circle skirts are ten times a bodice panel: by the share rule alone (here 0.9 of the largest
+    piece, so that this dress's skirt, three times its bodice panels, stands for one) only the skirt is stroked and
+    the bodice grows from it; pieces of at least `min_area_cm2` get strokes too (the waistbands, 191-214 cm², do
+    not)."""
+    pattern = load_pattern(CORPUS / "gc_s101_0009_specification.json")
+    torso = {"right_btorso", "right_ftorso", "left_btorso", "left_ftorso"}
+    shares_only = SuggestParams(settle=False, min_area_share=0.9, min_area_cm2=np.inf)
+    alone = suggest_strokes(mean_all, pattern, params=shares_only, surface=mean_surface)
+    assert {p.pattern.piece for p in alone.pairs} == {"skirt_back"}
+    with_floor = SuggestParams(settle=False, min_area_share=0.9, min_area_cm2=700.0)
+    strokes = suggest_strokes(mean_all, pattern, params=with_floor, surface=mean_surface)
+    check_strokes(strokes, pattern)
+    assert {p.pattern.piece for p in strokes.pairs} == {"skirt_back", "skirt_front"} | torso
+    for pair in strokes.pairs:
+        if pair.pattern.piece in torso:  # on the torso, above the waist
+            assert pair.body.points[:, 1].min() > 0.95 and np.abs(pair.body.points[:, 0]).max() < 0.25
 
 
 def test_suggest_for_a_kimono_from_the_generator(body, body_surface):

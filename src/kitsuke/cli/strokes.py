@@ -55,6 +55,13 @@ def register(parser: argparse.ArgumentParser) -> None:
         help="a piece gets a stroke when its area is at least this share of the largest piece's (default 0.15)",
     )
     p.add_argument(
+        "--min-area-cm2",
+        type=float,
+        default=None,
+        metavar="CM2",
+        help="... or at least this many cm² (default 500: a bodice's panels beside a skirt ten times their size)",
+    )
+    p.add_argument(
         "--no-raise",
         action="store_true",
         help="leave a garment where it rests even when it is tighter there than the body round it",
@@ -88,6 +95,10 @@ def run_suggest(args: argparse.Namespace) -> int:
     params = SuggestParams(fit=not args.no_raise)
     if args.min_area is not None:
         params = dataclasses.replace(params, min_area_share=args.min_area)
+    if args.min_area_cm2 is not None:
+        if not args.min_area_cm2 >= 0.0:
+            raise InputError(f"--min-area-cm2 must be an area in cm² (>= 0), got {args.min_area_cm2}")
+        params = dataclasses.replace(params, min_area_cm2=args.min_area_cm2)
     body = body_from_args(args)
     try:
         strokes = suggest_strokes(body, pattern, params=params)

@@ -3,17 +3,16 @@
     from kitsuke.dressing import suggest_strokes
     strokes = suggest_strokes(body, pattern)          # Strokes, pattern points in the pattern file's coordinates
 
-GarmentCode places every panel around its body, the kimono generator hangs its pieces as on a kimono stand. For
-each piece large enough to matter (`SuggestParams.min_area_share`; smaller ones, cuffs and waistbands, follow
-their seams), the pattern stroke runs along the piece's long axis through its middle, kept off its edges. Each of
-its points is carried to the body along the placed piece's normal (the body point nearest the placed point on
-that line, within `reach_m`), which keeps a sleeve's stroke on its arm where a nearest-point search would jump to
-the torso. The longest run of points that the body continues without a jump becomes the body stroke, and the
-longer of the two strokes is trimmed about its middle so that both have the same length. Last, the garment is
-wrapped once on these strokes and each body stroke moves to where its pattern stroke came to rest
-(`settled_strokes`): a placement is a layout, not where the sewn garment hangs. A garment that rests there tighter
-than the body round it (GarmentCode lays a skirt cut for the waist at the hips) is raised until it fits, its
-strokes with it (`_fit_height`).
+GarmentCode places every panel around its body, the kimono generator hangs its pieces as on a kimono stand. For each
+piece large enough to matter (`SuggestParams.min_area_share`, `min_area_cm2`; smaller ones, cuffs and waistbands,
+follow their seams), the pattern stroke runs along the piece's long axis through its middle, kept off its edges.
+Each of its points is carried to the body along the placed piece's normal (the body point nearest the placed point
+on that line, within `reach_m`), which keeps a sleeve's stroke on its arm where a nearest-point search would jump to
+the torso. The longest run of points that the body continues without a jump becomes the body stroke, and the longer
+of the two strokes is trimmed about its middle so that both have the same length. Last, the garment is wrapped once
+on these strokes and each body stroke moves to where its pattern stroke came to rest (`settled_strokes`): a
+placement is a layout, not where the sewn garment hangs. A garment that rests there tighter than the body round it
+(GarmentCode lays a skirt cut for the waist at the hips) is raised until it fits, its strokes with it (`_fit_height`).
 
 Two fallbacks, both after the carry along the normal (so a sleeve that reaches its arm keeps its stroke there):
 
@@ -49,7 +48,9 @@ FIT_ROUNDS = 2
 class SuggestParams:
     """Options of `suggest_strokes`.
 
-    min_area_share : a piece gets a stroke when its area is at least this share of the largest piece's.
+    min_area_share, min_area_cm2 : a piece gets a stroke when its area is at least this share of the largest
+        piece's, or at least min_area_cm2 (cm²): a bodice's panels beside a skirt ten times their size (GarmentCode's
+        circle skirts) are held by strokes of their own, not grown from the skirt's.
     margin_cm : the pattern stroke stays this far inside its piece's outline, cm.
     trim : share of the inside chord left out at each end (strokes drawn by hand stop short of the edges).
     step_cm : spacing of the stroke points, cm.
@@ -68,6 +69,7 @@ class SuggestParams:
     """
 
     min_area_share: float = 0.15
+    min_area_cm2: float = 500.0
     margin_cm: float = 2.0
     trim: float = 0.15
     step_cm: float = 2.0
@@ -82,6 +84,7 @@ class SuggestParams:
     def __post_init__(self) -> None:
         if not (
             0 <= self.min_area_share <= 1
+            and self.min_area_cm2 >= 0
             and self.margin_cm >= 0
             and 0 <= self.trim < 0.5
             and self.step_cm > 0
@@ -92,8 +95,8 @@ class SuggestParams:
             and self.drawn_in_below_m >= 0
         ):
             raise InputError(
-                "suggest parameters: 0 <= min_area_share <= 1, margin_cm >= 0, 0 <= trim < 0.5, step_cm > 0, "
-                "reach_m > 0, jump_m >= 0, min_length_cm > 0, drawn_in_reach_m > 0, "
+                "suggest parameters: 0 <= min_area_share <= 1, min_area_cm2 >= 0, margin_cm >= 0, 0 <= trim < 0.5, "
+                "step_cm > 0, reach_m > 0, jump_m >= 0, min_length_cm > 0, drawn_in_reach_m > 0, "
                 "drawn_in_below_m >= 0 required"
             )
 
@@ -239,7 +242,7 @@ def _smaller_pairs(pieces: list[Piece], surface: Surface, params: SuggestParams)
     dress's bodice on the body and its skirt panels, each eight times the bodice's pieces, far out)."""
     out, first = {}, None
     for piece in pieces:
-        if first is not None and piece.area < params.min_area_share * first:
+        if first is not None and piece.area < min(params.min_area_share * first, params.min_area_cm2):
             break
         got = suggest_pair(piece, surface, params)
         if got is not None:
@@ -273,7 +276,7 @@ def suggest_strokes(
     mesh = body if isinstance(body, TriMesh) else body.mesh
     surf = surface if surface is not None else Surface(mesh)
     by_size = sorted(placed, key=lambda pc: -pc.area)
-    big = [pc for pc in by_size if pc.area >= p.min_area_share * by_size[0].area]
+    big = [pc for pc in by_size if pc.area >= min(p.min_area_share * by_size[0].area, p.min_area_cm2)]
     found = {pc.name: suggest_pair(pc, surf, p) for pc in big}
     if not any(found.values()):
         found.update(_smaller_pairs(by_size[len(big) :], surf, p))
