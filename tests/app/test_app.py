@@ -633,7 +633,8 @@ def test_edit_points_in_the_browser(app_page, tmp_path):
     px = app_page.screen(board.to_board(piece, points[new_point : new_point + 1]) + [0, 0, 0.01])
     # On a loaded machine the browser can still hold the handles drawn before the split (their clicks name the old
     # points): once it has the new ones, the same click selects the new point.
-    for _ in range(10):
+    page.wait_for_timeout(2000)
+    for _ in range(15):
         view.tools.selected_point = None
         page.mouse.click(float(px[0, 0]), float(px[0, 1]))
         try:

@@ -72,6 +72,8 @@ class ClientView:
         client.scene.on_click()(self.tools.scene_clicked)  # corners of a piece being drawn (once: scenes are rebuilt)
         self._framed = False
         client.camera.on_update(self._first_camera_report)
+        if client.camera.update_timestamp:  # it reported while this view was being built
+            self._first_camera_report(client.camera)
 
     @property
     def editor(self) -> PatternEditor:
