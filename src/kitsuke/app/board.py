@@ -63,11 +63,9 @@ class BoardLayout:
         """(2, 3) board metres: the lowest and highest corner of the box round every piece; None without pieces."""
         if not self.places:
             return None
-        corners = [
-            p.origin + np.array([p.width_cm, p.height_cm]) * s for p in self.places.values() for s in (0.0, self.scale)
-        ]
-        xy = np.array(corners)
-        return np.c_[np.array([xy.min(axis=0), xy.max(axis=0)]), [self.z, self.z]]
+        low = np.array([p.origin for p in self.places.values()])
+        high = low + self.scale * np.array([[p.width_cm, p.height_cm] for p in self.places.values()])
+        return np.c_[np.array([low.min(axis=0), high.max(axis=0)]), [self.z, self.z]]
 
     def to_board(self, piece: str, points_cm: np.ndarray) -> np.ndarray:
         """(n, 3) board metres of (n, 2) piece-local centimetres."""

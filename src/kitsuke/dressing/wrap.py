@@ -77,6 +77,7 @@ from ..body.legs import leg_gap
 from ..cloth import BodyCollider, ClothModel, ClothParams, ClothState, RefinedPolish, Tethers
 from ..errors import ComputationError, InputError
 from ..geometry import TriMesh
+from ..geometry.surface import Surface
 from ..metrics import Girth, QualityReport, QualityTargets, garment_girth, quality_report, strain
 from ..pattern import Pattern, PatternMesh, face_layers, mesh_pattern
 from ._bridge import bridged, spans_legs
@@ -350,7 +351,7 @@ class _Prepared:
     pattern: Pattern | None
     strokes: Strokes
     collider: BodyCollider
-    surface: object
+    surface: Surface
     left_out: dict[str, float]
     timings: dict[str, float]
 
