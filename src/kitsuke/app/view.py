@@ -91,6 +91,8 @@ class ClientView:
     def fit_view(self) -> None:
         """Frame the body and the pattern board whole in the canvas left of the control panel (`framing.frame`)."""
         cam = self.client.camera
+        if not (cam.image_width > 0 and cam.image_height > 0):  # a hidden tab reports no canvas: nothing to fit
+            return
         mesh = self.session.body.mesh
         boxes = [mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)]
         board = self.board.bounds()
