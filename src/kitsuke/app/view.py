@@ -85,14 +85,14 @@ class ClientView:
         """The tab's size is known from its camera's first report: frame the scene in it, once (a later resize or
         orbit is the user's; "Fit view" frames again)."""
         if not self._framed:
-            self._framed = True
-            self.fit_view()
+            self._framed = self.fit_view()
 
-    def fit_view(self) -> None:
-        """Frame the body and the pattern board whole in the canvas left of the control panel (`framing.frame`)."""
+    def fit_view(self) -> bool:
+        """Frame the body and the pattern board whole in the canvas left of the control panel (`framing.frame`).
+        Returns False, doing nothing, for a tab that reports no canvas size (a hidden one)."""
         cam = self.client.camera
-        if not (cam.image_width > 0 and cam.image_height > 0):  # a hidden tab reports no canvas: nothing to fit
-            return
+        if not (cam.image_width > 0 and cam.image_height > 0):
+            return False
         mesh = self.session.body.mesh
         boxes = [mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)]
         board = self.board.bounds()
@@ -103,6 +103,7 @@ class ClientView:
         with self.client.atomic():
             cam.position = tuple(f.position)
             cam.look_at = tuple(f.look_at)
+        return True
 
     def _build_scene(self) -> None:
         from ..pattern import mesh_pattern
